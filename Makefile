@@ -1,0 +1,43 @@
+# ExplainDrive: set-up and common jobs. Every target creates .venv on first use.
+PY ?= python3.11
+VENV ?= .venv
+BIN := $(VENV)/bin
+
+.PHONY: demo test install dev-install system-deps lint typecheck bench clean
+
+$(BIN)/python:
+	$(PY) -m venv $(VENV)
+	$(BIN)/pip install --upgrade pip
+
+# torch is pinned first: 2.13.0 resolves to the CPU build; an unpinned torch pulls a CUDA build.
+install: $(BIN)/python
+	$(BIN)/pip install torch==2.13.0
+	$(BIN)/pip install -e .
+
+dev-install: $(BIN)/python
+	$(BIN)/pip install torch==2.13.0
+	$(BIN)/pip install -e '.[dev]'
+
+# Speech synthesis for audio tests and the browser for the web end-to-end test.
+system-deps:
+	@if command -v apt-get >/dev/null 2>&1 && { ! command -v espeak-ng >/dev/null || ! command -v chromium >/dev/null; }; then \
+		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+		$$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq espeak-ng chromium; \
+	fi
+
+demo: install
+	$(BIN)/explaindrive demo
+
+test: dev-install system-deps
+	$(BIN)/python -m pytest
+
+lint:
+	$(BIN)/ruff check src tests benchmarks scripts
+	$(BIN)/ruff format --check src tests benchmarks scripts
+	$(BIN)/mypy
+
+bench:
+	$(BIN)/python benchmarks/bench_env.py
+
+clean:
+	rm -rf $(VENV) build dist *.egg-info

@@ -1,0 +1,35 @@
+"""The action space: a change of the ego speed per 1 s decision step."""
+
+from __future__ import annotations
+
+SPEED_CHANGES_MPS: tuple[int, ...] = (-3, -2, -1, 0, 1, 2, 3)  # [m/s] per step
+N_ACTIONS = len(SPEED_CHANGES_MPS)
+STEP_LENGTH_S = 1.0  # [s] decision step = SUMO step
+IDLE_ACTION = SPEED_CHANGES_MPS.index(0)
+
+
+def speed_change(action: int) -> int:
+    """Speed change [m/s] of a discrete action index.
+
+    Raises:
+        ValueError: if ``action`` is not in ``range(N_ACTIONS)``.
+    """
+    if isinstance(action, bool) or not 0 <= int(action) < N_ACTIONS or int(action) != action:
+        raise ValueError(f"action {action!r} is outside the action space Discrete({N_ACTIONS})")
+    return SPEED_CHANGES_MPS[int(action)]
+
+
+def action_index(change_mps: int) -> int:
+    """Inverse of :func:`speed_change`.
+
+    Raises:
+        ValueError: if ``change_mps`` is not one of :data:`SPEED_CHANGES_MPS`.
+    """
+    if change_mps not in SPEED_CHANGES_MPS:
+        raise ValueError(f"speed change {change_mps!r} is not one of {SPEED_CHANGES_MPS}")
+    return SPEED_CHANGES_MPS.index(change_mps)
+
+
+def next_speed(v_mps: float, action: int) -> float:
+    """Ego speed after applying ``action`` for one step, clipped at 0."""
+    return max(0.0, v_mps + speed_change(action))
