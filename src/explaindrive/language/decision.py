@@ -1,0 +1,200 @@
+"""LLM-2 shared pieces: decisions, safety factors and the grounded rule engine.
+
+The rules follow the paper's three principles for the decision prompt:
+
+1. explain only when the action clearly conflicts with, or delays, the request for a
+   clear safety reason (decelerating under *fast*; harsh braking or acceleration under
+   *comfort*);
+2. never for ordinary, supportive or neutral behaviour;
+3. with several reasons, keep the most safety-critical one.
+
+Only objects within the cut-off (50 m) count.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from enum import StrEnum
+
+from explaindrive.commands import Command
+from explaindrive.language.config import SUMMARY_CUTOFF_M
+from explaindrive.language.summary import RecordState, StateRecord
+
+EXPLAIN_TAG = "[EXPLAIN]"
+NO_EXPLANATION_TAG = "[NO EXPLANATION NEEDED]"
+
+HOLD_MARGIN_MPS = 1.0  # [m/s] holding speed this far below the limit delays a "fast" request
+AT_LIMIT_MARGIN_MPS = 0.5  # [m/s] within this of the limit the limit explains braking
+SHORT_HEADWAY_S = 2.0  # [s] time headway below which the leader is a safety reason
+SHORT_TTC_S = 5.0  # [s] time to collision below which the leader is a safety reason
+MIN_GAP_M = 10.0  # [m] a leader closer than this is always a safety reason
+IMMINENT_TTC_S = 3.0  # [s] a leader this close in time outranks a traffic light
+IMMINENT_GAP_M = 5.0  # [m] ... and so does one this close in space
+COMFORT_DECEL_MPS2 = 2.0  # [m/s^2] comfortable braking, for the yellow-light dilemma zone
+
+
+class Factor(StrEnum):
+    """A safety-relevant factor an explanation can name."""
+
+    TRAFFIC_LIGHT = "traffic_light"
+    PEDESTRIAN = "pedestrian"
+    LEAD_VEHICLE = "lead_vehicle"
+    SPEED_LIMIT = "speed_limit"
+
+
+class Conflict(StrEnum):
+    """How an action goes against the request."""
+
+    NONE = "none"
+    SLOWS = "slows"  # braking or holding back although the passenger asked for more speed
+    HARSH_BRAKING = "harsh_braking"
+    HARSH_ACCELERATION = "harsh_acceleration"
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """Outcome of LLM-2 for one step.
+
+    Attributes:
+        explain: whether to explain the action to the passenger (tag ``[EXPLAIN]``).
+        factor: the most safety-critical factor (when ``explain``), else ``None``.
+        conflict: how the action goes against the request (``none`` if it does not).
+        reason: a short human-readable trace of the decision.
+        backend: backend that answered; ``fallback`` when ``embedded`` stood in.
+        latency_s: wall time of the call [s].
+        error: why the configured backend was bypassed, when ``fallback``.
+    """
+
+    explain: bool
+    factor: Factor | None
+    conflict: Conflict
+    reason: str
+    backend: str
+    fallback: bool = False
+    latency_s: float = 0.0
+    error: str | None = None
+
+    @property
+    def tag(self) -> str:
+        """The paper's output tag for this decision."""
+        return EXPLAIN_TAG if self.explain else NO_EXPLANATION_TAG
+
+
+class ExplanationDecider(ABC):
+    """LLM-2: decides whether an action needs explaining."""
+
+    name: str = "abstract"
+
+    @abstractmethod
+    def decide(self, record: StateRecord) -> Decision:
+        """Decide for one state record (never raises on a valid record)."""
+
+
+def parse_decision_tag(text: str) -> bool | None:
+    """``True`` for ``[EXPLAIN]``, ``False`` for ``[NO EXPLANATION NEEDED]``, else ``None``.
+
+    The reply must be exactly one tag (white space around it and case are tolerated).
+    """
+    reply = text.strip().upper()
+    if reply == EXPLAIN_TAG:
+        return True
+    if reply == NO_EXPLANATION_TAG:
+        return False
+    return None
+
+
+def detect_conflict(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> Conflict:
+    """How the record's action goes against its request (principles 1 and 2)."""
+    s = record.nearby(cutoff_m)
+    a = record.action
+    if record.command is Command.FAST:
+        if a < 0 or (a == 0 and s.v_ego < s.v_lim - HOLD_MARGIN_MPS):
+            return Conflict.SLOWS
+    elif record.command is Command.COMFORT:
+        if a <= -2:
+            return Conflict.HARSH_BRAKING
+        if a >= 2:
+            return Conflict.HARSH_ACCELERATION
+    # STOP: braking or standing is the request itself; the driving policy never has a
+    # safety reason in the state to keep going, so there is nothing to justify.
+    return Conflict.NONE
+
+
+def leader_is_hazard(s: RecordState) -> bool:
+    """Whether the leader is close enough (gap, headway or TTC) to be a safety reason."""
+    if s.d_lead is None:
+        return False
+    return s.d_lead < MIN_GAP_M or _headway_s(s) < SHORT_HEADWAY_S or _ttc_s(s) < SHORT_TTC_S
+
+
+def _headway_s(s: RecordState) -> float:
+    assert s.d_lead is not None
+    return s.d_lead / s.v_ego if s.v_ego > 0.1 else math.inf
+
+
+def _ttc_s(s: RecordState) -> float:
+    assert s.d_lead is not None
+    dv = s.dv or 0.0
+    return s.d_lead / dv if dv > 0.1 else math.inf
+
+
+def braking_factors(s: RecordState) -> list[Factor]:
+    """Safety reasons for slowing down, most critical first.
+
+    Order: an occupied pedestrian crossing; an imminent leader (TTC < 3 s or gap < 5 m);
+    a red or yellow light; a leader at short headway / TTC; being at the speed limit.
+    """
+    found: list[Factor] = []
+    if s.d_cross is not None:
+        found.append(Factor.PEDESTRIAN)
+    hazard = leader_is_hazard(s)
+    imminent = hazard and (_ttc_s(s) < IMMINENT_TTC_S or (s.d_lead or 0.0) < IMMINENT_GAP_M)
+    if imminent:
+        found.append(Factor.LEAD_VEHICLE)
+    if s.tl_state in ("red", "yellow"):
+        found.append(Factor.TRAFFIC_LIGHT)
+    if hazard and not imminent:
+        found.append(Factor.LEAD_VEHICLE)
+    if s.v_ego >= s.v_lim - AT_LIMIT_MARGIN_MPS:
+        found.append(Factor.SPEED_LIMIT)
+    return found
+
+
+def acceleration_factors(s: RecordState) -> list[Factor]:
+    """Safety reasons for accelerating firmly: a yellow light too close to stop comfortably."""
+    if s.tl_state == "yellow" and s.d_tl is not None:
+        stopping_m = s.v_ego**2 / (2 * COMFORT_DECEL_MPS2)
+        if s.d_tl < stopping_m:
+            return [Factor.TRAFFIC_LIGHT]
+    return []
+
+
+def rule_decision(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> Decision:
+    """The grounded rule engine: the embedded LLM-2 (latency and backend filled by callers)."""
+    conflict = detect_conflict(record, cutoff_m)
+    if conflict is Conflict.NONE:
+        return Decision(False, None, conflict, "action is ordinary or supports the request",
+                        backend="embedded")
+    s = record.nearby(cutoff_m)
+    factors = (
+        acceleration_factors(s) if conflict is Conflict.HARSH_ACCELERATION else braking_factors(s)
+    )
+    if not factors:
+        return Decision(False, None, conflict,
+                        f"{conflict.value} but no safety reason within {cutoff_m:g} m",
+                        backend="embedded")
+    names = ", ".join(f.value for f in factors)
+    return Decision(True, factors[0], conflict,
+                    f"{conflict.value} for {factors[0].value} (candidates: {names})",
+                    backend="embedded")
+
+
+def most_critical_factor(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> Factor | None:
+    """The factor to explain: the rule engine's choice, else the first braking factor."""
+    decision = rule_decision(record, cutoff_m)
+    if decision.factor is not None:
+        return decision.factor
+    factors = braking_factors(record.nearby(cutoff_m))
+    return factors[0] if factors else None

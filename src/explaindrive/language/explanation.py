@@ -1,0 +1,215 @@
+"""LLM-3 shared pieces: explanations, the template generator and the grounding check."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+from explaindrive.language.config import SUMMARY_CUTOFF_M
+from explaindrive.language.decision import Factor
+from explaindrive.language.summary import RecordState, StateRecord
+
+# Words that name each factor; used to check that a text is grounded in the state.
+_FACTOR_PATTERNS: dict[Factor, re.Pattern[str]] = {
+    Factor.TRAFFIC_LIGHT: re.compile(r"\b(traffic[- ]lights?|lights?|signals?)\b", re.I),
+    Factor.PEDESTRIAN: re.compile(
+        r"\b(pedestrians?|crosswalk|zebra|someone crossing|people crossing|person crossing)\b",
+        re.I,
+    ),
+    Factor.LEAD_VEHICLE: re.compile(
+        r"\b(vehicles?|cars?|trucks?|bus|van|leader)\s+(ahead|in front)|\b(vehicle|car) "
+        r"(just )?ahead|\bleading (vehicle|car)|\bheadway\b|\bthe (car|vehicle) in front",
+        re.I,
+    ),
+    Factor.SPEED_LIMIT: re.compile(r"\bspeed[- ]limits?\b|\blimit\b", re.I),
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Explanation:
+    """Outcome of LLM-3.
+
+    Attributes:
+        text: one or two sentences for the passenger.
+        factor: the factor the explanation is about.
+        backend: backend that answered; ``fallback`` when ``embedded`` stood in.
+        latency_s: wall time of the call [s].
+        error: why the configured backend was bypassed, when ``fallback``.
+    """
+
+    text: str
+    factor: Factor | None
+    backend: str
+    fallback: bool = False
+    latency_s: float = 0.0
+    error: str | None = None
+
+
+class Explainer(ABC):
+    """LLM-3: explains an action that goes against the passenger's request."""
+
+    name: str = "abstract"
+
+    @abstractmethod
+    def explain(self, record: StateRecord, factor: Factor | None) -> Explanation:
+        """Explain the record's action, naming ``factor`` (from the decision)."""
+
+
+def mentioned_factors(text: str) -> set[Factor]:
+    """Factors a text names (by the vocabulary of :data:`_FACTOR_PATTERNS`)."""
+    return {f for f, pattern in _FACTOR_PATTERNS.items() if pattern.search(text)}
+
+
+def present_factors(state: RecordState) -> set[Factor]:
+    """Factors present in a (cut-off) state; the speed limit is always present."""
+    found = {Factor.SPEED_LIMIT}
+    if state.d_tl is not None:
+        found.add(Factor.TRAFFIC_LIGHT)
+    if state.d_cross is not None:
+        found.add(Factor.PEDESTRIAN)
+    if state.d_lead is not None:
+        found.add(Factor.LEAD_VEHICLE)
+    return found
+
+
+@dataclass(frozen=True, slots=True)
+class Grounding:
+    """Result of :func:`check_grounding`."""
+
+    names_factor: bool
+    absent: tuple[Factor, ...]
+
+    @property
+    def ok(self) -> bool:
+        """The text names the expected factor and nothing absent from the state."""
+        return self.names_factor and not self.absent
+
+
+def check_grounding(
+    text: str, factor: Factor | None, record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M
+) -> Grounding:
+    """Check that ``text`` names ``factor`` and no factor absent from the state."""
+    said = mentioned_factors(text)
+    absent = tuple(sorted(said - present_factors(record.nearby(cutoff_m))))
+    return Grounding(names_factor=factor is None or factor in said, absent=absent)
+
+
+# --- the embedded generator ----------------------------------------------------------------
+
+_OPENERS: dict[str, tuple[str, ...]] = {
+    "brake": ("I'm slowing down", "I'm easing off a little", "I'm reducing our speed"),
+    "harsh_brake": (
+        "Sorry for the firm braking",
+        "Apologies for braking a bit sharply",
+        "Sorry about that quick stop",
+    ),
+    "hold": ("I'm holding our speed for now", "I'm not speeding up just yet",
+             "I'm keeping us steady for a moment"),
+    "wait": ("We're waiting here for a moment", "I'm keeping us stopped for now",
+             "We're staying put for a moment"),
+    "accelerate": ("Sorry for the quick acceleration", "Apologies for the sudden burst of speed",
+                   "Sorry for speeding up so briskly"),
+}
+
+_REASONS: dict[Factor, tuple[str, ...]] = {
+    Factor.PEDESTRIAN: (
+        "because a pedestrian is crossing the street {d_cross} m ahead",
+        "to let a pedestrian cross safely {d_cross} m ahead of us",
+        "since someone is on the pedestrian crossing {d_cross} m ahead",
+    ),
+    Factor.TRAFFIC_LIGHT: (
+        "because the traffic light {d_tl} m ahead is {tl_state}",
+        "since the light {d_tl} m ahead of us is {tl_state}",
+        "as the traffic light coming up in {d_tl} m is {tl_state}",
+    ),
+    Factor.LEAD_VEHICLE: (
+        "to keep a safe distance from the vehicle ahead, {d_lead} m away",
+        "because the car ahead is only {d_lead} m away",
+        "to leave enough room to the vehicle in front, which is {d_lead} m ahead",
+    ),
+    Factor.SPEED_LIMIT: (
+        "to stay within the {v_lim_kmh} km/h speed limit here",
+        "because the speed limit on this stretch is {v_lim_kmh} km/h",
+        "so that we respect the {v_lim_kmh} km/h speed limit",
+    ),
+}
+
+_ACCEL_REASON = (
+    "the traffic light {d_tl} m ahead just turned yellow and it is safer to clear the "
+    "intersection than to brake hard"
+)
+
+_CLOSERS: dict[Factor, tuple[str, ...]] = {
+    Factor.PEDESTRIAN: (
+        "We'll continue as soon as the way is clear.",
+        "Their safety comes first, and we'll be moving again shortly.",
+        "It only takes a moment, thanks for your patience.",
+    ),
+    Factor.TRAFFIC_LIGHT: (
+        "We'll be on our way again as soon as it turns green.",
+        "We'll pick up speed again right after it changes.",
+        "It won't be long, thanks for your patience.",
+    ),
+    Factor.LEAD_VEHICLE: (
+        "We'll speed up again once there's more room.",
+        "Keeping this gap keeps the ride safe for everyone.",
+        "I'll pick up the pace as soon as it is safe.",
+    ),
+    Factor.SPEED_LIMIT: (
+        "We'll still get you there safely and on time.",
+        "Driving faster here would not be safe or legal.",
+        "Thanks for understanding, we're making good progress.",
+    ),
+}
+
+
+def _pick(options: tuple[str, ...], key: str) -> str:
+    digest = hashlib.blake2b(key.encode(), digest_size=4).digest()
+    return options[int.from_bytes(digest, "big") % len(options)]
+
+
+def _opener_kind(record: StateRecord, state: RecordState) -> str:
+    if record.action >= 2 and record.request == "comfort":
+        return "accelerate"
+    if record.request == "comfort" and record.action <= -2:
+        return "harsh_brake"
+    if record.action < 0:
+        return "brake"
+    return "wait" if state.v_ego < 0.1 else "hold"
+
+
+def template_explanation(
+    record: StateRecord, factor: Factor, cutoff_m: float = SUMMARY_CUTOFF_M
+) -> str:
+    """One or two friendly sentences naming ``factor`` with its distance (deterministic).
+
+    The wording varies with the record (a hash picks among several phrasings) but
+    only the chosen factor and values from the state are ever mentioned.
+
+    Raises:
+        ValueError: if ``factor`` is not present in the record's state within ``cutoff_m``.
+    """
+    s = record.nearby(cutoff_m)
+    if factor not in present_factors(s):
+        raise ValueError(f"factor {factor.value} is not in the state within {cutoff_m:g} m")
+    values = {
+        "d_cross": f"{s.d_cross:.0f}" if s.d_cross is not None else "",
+        "d_tl": f"{s.d_tl:.0f}" if s.d_tl is not None else "",
+        "tl_state": s.tl_state or "",
+        "d_lead": f"{s.d_lead:.0f}" if s.d_lead is not None else "",
+        "v_lim_kmh": f"{round(s.v_lim * 3.6)}",
+    }
+    key = record.model_dump_json()
+    kind = _opener_kind(record, s)
+    opener = _pick(_OPENERS[kind], key + "o")
+    if kind == "accelerate" and factor is Factor.TRAFFIC_LIGHT:
+        return f"{opener}: {_ACCEL_REASON.format(**values)}. Everything is under control."
+    if kind == "accelerate":  # harsh acceleration is only ever explained by a yellow light
+        raise ValueError(f"harsh acceleration cannot be explained by {factor.value}")
+    reason = _pick(_REASONS[factor], key + "r").format(**values)
+    closer = _pick(_CLOSERS[factor], key + "c")
+    if kind == "harsh_brake":
+        return f"{opener}, I had to slow down {reason}. {closer}"
+    return f"{opener} {reason}. {closer}"
