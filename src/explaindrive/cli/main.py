@@ -1,0 +1,38 @@
+"""The ``explaindrive`` command: assembles the per-command modules."""
+
+from __future__ import annotations
+
+import importlib
+import logging
+
+import typer
+
+app = typer.Typer(
+    name="explaindrive",
+    help="Passenger-directed, explainable autonomous driving in SUMO.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+# Each module exposes ``register(app)``; one line per command module.
+_COMMAND_MODULES: tuple[str, ...] = (
+    "explaindrive.cli.demo",
+    "explaindrive.cli.scenario",
+)
+
+
+@app.callback()
+def _root(verbose: bool = typer.Option(False, "--verbose", "-v", help="Debug logging.")) -> None:
+    logging.basicConfig(
+        level=logging.DEBUG if verbose else logging.WARNING,
+        format="%(levelname)s %(name)s: %(message)s",
+    )
+
+
+for _name in _COMMAND_MODULES:
+    importlib.import_module(_name).register(app)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    app()

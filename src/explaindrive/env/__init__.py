@@ -1,0 +1,1 @@
+"""The Gymnasium driving environment: observation, action, reward and metrics."""

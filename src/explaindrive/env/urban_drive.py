@@ -1,0 +1,471 @@
+"""``explaindrive/UrbanDrive-v0``: longitudinal control of the ego car in the urban SUMO scenario.
+
+Each step is 1 s. The action changes the ego speed by -3..+3 m/s; SUMO's own
+safety checks for the ego are off (speed mode 0), so collisions, red-light runs,
+pedestrian-yield and speed-limit violations can happen and are counted.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import traci.constants as tc
+from numpy.typing import NDArray
+
+from explaindrive.commands import Command
+from explaindrive.env import state as S
+from explaindrive.env.actions import N_ACTIONS, STEP_LENGTH_S, speed_change
+from explaindrive.env.config import EnvConfig
+from explaindrive.env.options import ResetOptions
+from explaindrive.env.reward import (
+    STOP_REASON_GAP_M,
+    StepFeatures,
+    reward_terms,
+    time_headway,
+    time_to_collision,
+)
+from explaindrive.sim.connection import SumoConnection
+from explaindrive.sim.route import RouteGeometry, load_route_geometry
+from explaindrive.sim.scenario.files import (
+    EGO_ID,
+    EGO_ROUTE_ID,
+    EGO_TYPE_ID,
+    ScenarioFiles,
+    default_cache_dir,
+    default_scenario,
+)
+from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES
+
+log = logging.getLogger(__name__)
+
+_EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER)
+_SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS,)
+EGO_LENGTH_M = 5.0  # [m] as in the ego vType
+
+
+@dataclass(slots=True)
+class _Leader:
+    gap_m: float
+    speed_mps: float
+    length_m: float
+    virtual: bool
+
+
+@dataclass(slots=True)
+class _Episode:
+    """Mutable per-episode bookkeeping."""
+
+    command: Command
+    schedule: list[tuple[float, Command]]
+    start_pos_m: float
+    steps: int = 0
+    speed_mps: float = 0.0
+    accel_mps2: float = 0.0
+    pos_m: float = 0.0
+    light_state: dict[str, S.LightState] = field(default_factory=dict)
+    occupied: dict[str, bool] = field(default_factory=dict)
+    done: bool = False
+
+
+class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
+    """The paper's command-conditioned driving task in the urban scenario.
+
+    Args:
+        config: an :class:`EnvConfig` or a mapping of its fields (unknown keys rejected).
+        render_mode: ``None`` (libsumo, headless) or ``"human"`` (sumo-gui over TraCI).
+        **overrides: individual config fields, e.g. ``traffic_level=0.5``.
+
+    Reset options: ``command`` (fast|comfort|stop), ``traffic_level``, and
+    ``command_schedule`` [(time_s, command), ...]. See :mod:`explaindrive.env.state`
+    for the observation and :mod:`explaindrive.env.reward` for the rewards.
+    """
+
+    metadata = {"render_modes": ["human"], "render_fps": 1}  # noqa: RUF012
+
+    def __init__(
+        self,
+        config: EnvConfig | Mapping[str, Any] | None = None,
+        render_mode: str | None = None,
+        **overrides: Any,
+    ) -> None:
+        super().__init__()
+        if render_mode not in (None, "human"):
+            raise ValueError(f"render_mode must be None or 'human', got {render_mode!r}")
+        if isinstance(config, EnvConfig):
+            cfg = EnvConfig.from_mapping({**_asdict(config), **overrides}) if overrides else config
+        else:
+            cfg = EnvConfig.from_mapping({**dict(config or {}), **overrides})
+        self.config = cfg
+        self.render_mode = render_mode
+        cache = cfg.cache_dir or default_cache_dir()
+        self.scenario: ScenarioFiles = (
+            ScenarioFiles(net_file=cfg.net_file, cache_dir=cache)
+            if cfg.net_file
+            else default_scenario(cache)
+        )
+        self.scenario.check()
+        self.geometry: RouteGeometry = load_route_geometry(self.scenario.net_file, EGO_ROUTE_EDGES)
+        if cfg.normalize_obs:
+            low, high = S.normalize(S.STATE_LOW), S.normalize(S.STATE_HIGH)
+        else:
+            low, high = S.STATE_LOW, S.STATE_HIGH
+        self.observation_space = gym.spaces.Box(low=low, high=high, dtype=np.float32)
+        self.action_space = gym.spaces.Discrete(N_ACTIONS)
+        self._conn = SumoConnection(gui=render_mode == "human")
+        self._ep: _Episode | None = None
+        self._leader_len: dict[str, float] = {}
+        self._tls_link: dict[str, int] = {}  # traffic light -> index of the ego's link
+        self._last_obs = np.zeros(S.STATE_DIM, dtype=np.float32)
+
+    # ------------------------------------------------------------------ public API
+    @property
+    def command(self) -> Command:
+        """The active passenger command."""
+        return self._episode().command
+
+    def set_command(self, command: str | int | Command) -> None:
+        """Change the passenger command; it applies from the next action on.
+
+        Raises:
+            ValueError: for an unknown command.
+        """
+        cmd = Command.parse(command)
+        ep = self._episode()
+        ep.command = cmd
+        self._last_obs[S.CMD] = float(cmd)
+
+    @property
+    def time_s(self) -> float:
+        """Seconds since the ego entered."""
+        return float(self._episode().steps) * STEP_LENGTH_S
+
+    @property
+    def sumo(self) -> Any:
+        """The running ``libsumo``/``traci`` module, for read-only inspection (e.g. rendering)."""
+        return self._conn.api
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[NDArray[np.float32], dict[str, Any]]:
+        """Start an episode: warmed-up traffic (cached state), then the ego enters.
+
+        The same ``seed`` (and traffic level) gives the same episode.
+        """
+        super().reset(seed=seed)
+        opts = ResetOptions.parse(options)
+        level = opts.traffic_level if opts.traffic_level is not None else self.config.traffic_level
+        sumo_seed = seed if seed is not None else int(self.np_random.integers(0, 2**31 - 1))
+        if isinstance(sumo_seed, bool) or not 0 <= int(sumo_seed) < 2**31:
+            raise ValueError(f"seed must be an integer in [0, 2**31), got {seed!r}")
+        try:
+            self._conn.start_or_load(self._sumo_args(level, int(sumo_seed)))
+            self._restore_warm_state(level, int(sumo_seed))
+            start_pos = self._insert_ego()
+        except BaseException:
+            self.close()
+            raise
+        schedule = list(opts.command_schedule)
+        self._ep = _Episode(command=opts.command, schedule=schedule, start_pos_m=start_pos)
+        self._apply_schedule(0.0)
+        self._ep.pos_m = start_pos
+        obs, _leader, _ = self._observe()
+        self._last_obs = obs
+        info = {"command": self._ep.command.label, "traffic_level": level, "seed": int(sumo_seed),
+                "time_s": 0.0, "distance_m": 0.0}
+        return self._output(obs), info
+
+    def step(
+        self, action: int | np.integer[Any]
+    ) -> tuple[NDArray[np.float32], float, bool, bool, dict[str, Any]]:
+        """Apply a speed change for one 1 s step.
+
+        Raises:
+            ValueError: if ``action`` is outside ``Discrete(7)``.
+            RuntimeError: if the episode is over (call ``reset``).
+        """
+        ep = self._episode()
+        if ep.done:
+            raise RuntimeError("the episode is over; call reset() before step()")
+        change = speed_change(int(action)) if isinstance(action, int | np.integer) else speed_change(action)
+        api = self._conn.api
+        cmd = ep.command
+        prev_obs = self._last_obs
+        prev_pos = ep.pos_m
+        v_new = max(0.0, ep.speed_mps + change)
+        try:
+            api.vehicle.setSpeed(EGO_ID, v_new)
+            api.simulationStep()
+        except BaseException:
+            self.close()
+            raise
+        ep.steps += 1
+        collided = self._ego_collided()
+        sim = api.simulation.getSubscriptionResults()
+        arrived = EGO_ID in sim.get(tc.VAR_ARRIVED_VEHICLES_IDS, ())
+        present = not collided and not arrived
+        accel = v_new - ep.speed_mps
+        jerk = accel - ep.accel_mps2
+        if present:
+            ego = api.vehicle.getSubscriptionResults(EGO_ID)
+            v_new = float(ego[tc.VAR_SPEED])
+            ep.pos_m = ep.start_pos_m + float(ego[tc.VAR_DISTANCE])
+        else:
+            ep.pos_m = prev_pos + v_new * STEP_LENGTH_S
+        red_run = self._ran_red_light(prev_pos, ep.pos_m)
+        ped_violation = self._violated_crossing(prev_pos, ep.pos_m)
+        legal_limit = self.geometry.limit_at(ep.pos_m)
+        speeding = v_new > legal_limit + 1e-6
+        ep.speed_mps, ep.accel_mps2 = v_new, accel
+        self._apply_schedule(ep.steps * STEP_LENGTH_S)
+
+        if present:
+            obs, leader, real = self._observe()
+        else:
+            obs, leader, real = prev_obs.copy(), None, None
+            obs[S.V_EGO] = v_new
+            obs[S.CMD] = float(ep.command)
+        gap = leader.gap_m if leader else math.inf
+        closing = (v_new - leader.speed_mps) if leader else 0.0
+        ttc = time_to_collision(gap, closing) if leader else math.inf
+        headway = time_headway(gap, leader.length_m, v_new) if leader else math.inf
+        stop_reason: str | None = None
+        if leader is not None and gap <= STOP_REASON_GAP_M:
+            stop_reason = "signal" if leader.virtual else "queue"
+        features = StepFeatures(
+            speed_mps=v_new,
+            speed_change_mps=change,
+            limit_mps=float(prev_obs[S.V_LIM]),
+            ttc_s=ttc,
+            headway_s=headway,
+            jerk_mps3=jerk,
+            violation=red_run or ped_violation,
+            stop_reason=stop_reason,
+            collided=collided,
+        )
+        terms = reward_terms(cmd, features)
+        terminated = collided or arrived
+        truncated = not terminated and ep.steps >= self.config.max_steps
+        ep.done = terminated or truncated
+        self._last_obs = obs
+        info = {
+            "command": cmd.label,
+            "next_command": ep.command.label,
+            "time_s": ep.steps * STEP_LENGTH_S,
+            "speed_mps": v_new,
+            "speed_change_mps": change,
+            "accel_mps2": accel,
+            "jerk_mps3": jerk,
+            "limit_mps": legal_limit,
+            "posted_limit_mps": float(prev_obs[S.V_LIM]),
+            "gap_m": gap,
+            "leader_virtual": bool(leader.virtual) if leader else False,
+            "ttc_s": ttc,
+            "headway_s": headway,
+            "real_gap_m": real.gap_m if real else math.inf,
+            "real_ttc_s": time_to_collision(real.gap_m, v_new - real.speed_mps) if real else math.inf,
+            "real_headway_s": time_headway(real.gap_m, real.length_m, v_new) if real else math.inf,
+            "distance_m": ep.pos_m - ep.start_pos_m,
+            "collision": collided,
+            "red_light_run": red_run,
+            "ped_violation": ped_violation,
+            "speeding": speeding,
+            "arrived": arrived,
+            "reward_terms": terms.as_dict(),
+        }
+        return self._output(obs), terms.total, terminated, truncated, info
+
+    def close(self) -> None:
+        """Stop SUMO (idempotent)."""
+        self._conn.close()
+        self._ep = None
+
+    # ------------------------------------------------------------------ SUMO plumbing
+    def _episode(self) -> _Episode:
+        if self._ep is None:
+            raise RuntimeError("no episode is running; call reset() first")
+        return self._ep
+
+    def _sumo_args(self, level: float, seed: int) -> list[str]:
+        return [
+            "-n", str(self.scenario.net_file),
+            "-r", str(self.scenario.routes_file(level)),
+            "--seed", str(seed),
+            "--step-length", str(STEP_LENGTH_S),
+            "--no-step-log", "true",
+            "--no-warnings", "true",
+            "--collision.action", "remove",
+            "--collision.check-junctions", "true",
+            "--collision.mingap-factor", "0",
+            "--save-state.rng", "true",
+            "--time-to-teleport", "300",
+        ]
+
+    def _state_file(self, level: float, seed: int) -> Path:
+        return self.scenario.state_dir() / f"level{level:g}_seed{seed}_w{self.config.warmup_s}.xml"
+
+    def _restore_warm_state(self, level: float, seed: int) -> None:
+        api = self._conn.api
+        path = self._state_file(level, seed)
+        if not path.exists():
+            for _ in range(self.config.warmup_s):
+                api.simulationStep()
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".xml")
+            os.close(fd)
+            api.simulation.saveState(tmp)
+            os.replace(tmp, path)
+        # Always continue from the saved file so that a fresh and a cached run agree.
+        api.simulation.loadState(str(path))
+
+    def _insert_ego(self) -> float:
+        api = self._conn.api
+        api.vehicle.add(
+            EGO_ID, EGO_ROUTE_ID, typeID=EGO_TYPE_ID, depart="now",
+            departLane="best", departPos="base", departSpeed="0",
+        )
+        for _ in range(self.config.insert_timeout_s):
+            api.simulationStep()
+            if EGO_ID in api.simulation.getDepartedIDList():
+                break
+        else:
+            raise RuntimeError(
+                f"the ego could not enter within {self.config.insert_timeout_s} s "
+                "(the first road stays blocked); lower the traffic level"
+            )
+        api.vehicle.setSpeedMode(EGO_ID, 0)  # no car-following, light or right-of-way checks
+        api.vehicle.setLaneChangeMode(EGO_ID, 0)
+        api.vehicle.setSpeed(EGO_ID, 0.0)
+        api.vehicle.subscribe(EGO_ID, _EGO_VARS, parameters={tc.VAR_LEADER: S.SENSOR_RANGE_M})
+        if not self._tls_link:
+            self._tls_link = {t[0]: int(t[1]) for t in api.vehicle.getNextTLS(EGO_ID)}
+        for tls_id in self._tls_link:
+            api.trafficlight.subscribe(tls_id, (tc.TL_RED_YELLOW_GREEN_STATE,))
+        api.simulation.subscribe(_SIM_VARS)
+        for crossing in self.geometry.crossings:
+            for edge in (crossing.crossing_edge, *crossing.walkingareas):
+                api.edge.subscribe(edge, (tc.LAST_STEP_PERSON_ID_LIST,))
+        return float(api.vehicle.getLanePosition(EGO_ID))
+
+    def _apply_schedule(self, now_s: float) -> None:
+        ep = self._episode()
+        while ep.schedule and ep.schedule[0][0] <= now_s + 1e-9:
+            ep.command = ep.schedule.pop(0)[1]
+
+    def _ego_collided(self) -> bool:
+        for col in self._conn.api.simulation.getCollisions():
+            if EGO_ID in (col.collider, col.victim):
+                return True
+        return False
+
+    # ------------------------------------------------------------------ perception
+    def _persons(self, edge: str) -> tuple[str, ...]:
+        res = self._conn.api.edge.getSubscriptionResults(edge)
+        return tuple(res.get(tc.LAST_STEP_PERSON_ID_LIST, ()))
+
+    def _crossing_occupied(self, crossing_edge: str, walkingareas: tuple[str, ...]) -> bool:
+        """A pedestrian is on the crossing or about to step onto it."""
+        if self._persons(crossing_edge):
+            return True
+        person = self._conn.api.person
+        return any(
+            person.getNextEdge(pid) == crossing_edge
+            for wa in walkingareas
+            for pid in self._persons(wa)
+        )
+
+    def _observe(self) -> tuple[NDArray[np.float32], _Leader | None, _Leader | None]:
+        """Observation, effective leader (real or virtual) and real leader."""
+        api = self._conn.api
+        ep = self._episode()
+        ego = api.vehicle.getSubscriptionResults(EGO_ID)
+        v = float(ego[tc.VAR_SPEED])
+        pos = ep.pos_m
+        rng = S.SENSOR_RANGE_M
+
+        real: _Leader | None = None
+        lead = ego.get(tc.VAR_LEADER)
+        if lead and lead[0] and 0 <= lead[1] < rng:  # lead = (id, gap)
+            lid = lead[0]
+            length = self._leader_len.get(lid)
+            if length is None:
+                length = self._leader_len[lid] = float(api.vehicle.getLength(lid))
+            real = _Leader(max(float(lead[1]), 0.0), float(api.vehicle.getSpeed(lid)), length, False)
+        leader = real
+
+        d_tl, tls = rng, S.LightState.GREEN
+        ep.light_state = {}
+        for light in self.geometry.lights:
+            ahead = light.stop_line_m - pos
+            if ahead < 0.0 or light.tls_id not in self._tls_link:
+                continue
+            states = api.trafficlight.getSubscriptionResults(light.tls_id)
+            colour = S.LightState.from_sumo(
+                states[tc.TL_RED_YELLOW_GREEN_STATE][self._tls_link[light.tls_id]]
+            )
+            ep.light_state[light.tls_id] = colour
+            if ahead < rng:
+                d_tl, tls = ahead, colour
+            break
+        if d_tl < rng and tls is not S.LightState.GREEN and (leader is None or d_tl < leader.gap_m):
+            leader = _Leader(max(d_tl, 0.0), 0.0, 0.0, True)
+
+        d_cross = rng
+        ep.occupied = {}
+        for crossing in self.geometry.crossings:
+            ahead = crossing.stop_line_m - pos
+            if -EGO_LENGTH_M - 5.0 <= ahead < rng:
+                busy = self._crossing_occupied(crossing.crossing_edge, crossing.walkingareas)
+                ep.occupied[crossing.crossing_edge] = bool(self._persons(crossing.crossing_edge))
+                if busy and ahead >= 0.0 and ahead < d_cross:
+                    d_cross = ahead
+        if d_cross < rng and (leader is None or d_cross < leader.gap_m):
+            leader = _Leader(d_cross, 0.0, 0.0, True)
+
+        obs = np.array(
+            [
+                float(ep.command),
+                v,
+                self.geometry.posted_limit(pos),
+                leader.gap_m if leader else rng,
+                (v - leader.speed_mps) if leader else 0.0,
+                d_tl,
+                float(tls),
+                d_cross,
+            ],
+            dtype=np.float32,
+        )
+        np.clip(obs, S.STATE_LOW, S.STATE_HIGH, out=obs)
+        return obs, leader, real
+
+    def _ran_red_light(self, prev_pos: float, pos: float) -> bool:
+        ep = self._episode()
+        for light in self.geometry.lights:
+            if prev_pos < light.stop_line_m <= pos:
+                return ep.light_state.get(light.tls_id) is S.LightState.RED
+        return False
+
+    def _violated_crossing(self, prev_pos: float, pos: float) -> bool:
+        ep = self._episode()
+        for crossing in self.geometry.crossings:
+            if prev_pos < crossing.stop_line_m <= pos:
+                was = ep.occupied.get(crossing.crossing_edge, False)
+                return was or bool(self._persons(crossing.crossing_edge))
+        return False
+
+    def _output(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
+        return S.normalize(obs) if self.config.normalize_obs else obs.copy()
+
+
+def _asdict(cfg: EnvConfig) -> dict[str, Any]:
+    import dataclasses
+
+    return {f.name: getattr(cfg, f.name) for f in dataclasses.fields(cfg)}

@@ -1,0 +1,1 @@
+"""SUMO side: locating SUMO, the urban scenario, demand, and the simulation connection."""

@@ -1,0 +1,168 @@
+"""Geometry of the ego route read from a SUMO network: positions of stop lines,
+crossings and speed-limit zones measured along the route.
+
+Route positions are in metres from the start of the first route edge and
+include the internal (junction) lanes, so they match SUMO's odometer.
+"""
+
+from __future__ import annotations
+
+import bisect
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+SPEED_SIGN_LOOKAHEAD_M = 40.0  # [m] a lower limit ahead applies from this distance on
+
+
+@dataclass(frozen=True, slots=True)
+class RouteLight:
+    """A traffic light on the route."""
+
+    tls_id: str
+    stop_line_m: float  # [m] route position of the stop line
+
+
+@dataclass(frozen=True, slots=True)
+class RouteCrossing:
+    """A pedestrian crossing over the route."""
+
+    crossing_edge: str  # SUMO internal edge id of the crossing (":PX_c0")
+    walkingareas: tuple[str, ...]  # walking areas from which pedestrians enter it
+    stop_line_m: float  # [m] route position where the ego must stop for it
+    signalized: bool
+
+
+@dataclass(frozen=True, slots=True)
+class RouteGeometry:
+    """Static geometry of the ego route."""
+
+    edges: tuple[str, ...]
+    edge_start_m: tuple[float, ...]  # [m] route position of each edge's start
+    length_m: float  # [m] route position of the end of the last edge
+    zone_start_m: tuple[float, ...]  # [m] start of each constant-limit stretch
+    zone_limit_mps: tuple[float, ...]  # [m/s] its limit
+    lights: tuple[RouteLight, ...]
+    crossings: tuple[RouteCrossing, ...]
+
+    def limit_at(self, pos_m: float) -> float:
+        """Legal speed limit [m/s] at a route position."""
+        i = bisect.bisect_right(self.zone_start_m, pos_m) - 1
+        return self.zone_limit_mps[max(i, 0)]
+
+    def posted_limit(self, pos_m: float, lookahead_m: float = SPEED_SIGN_LOOKAHEAD_M) -> float:
+        """Limit the driver must respect at ``pos_m``: the lowest limit within ``lookahead_m``.
+
+        This models speed-limit signs that are visible before the zone starts, so a
+        lower limit ahead is known in time to brake for it.
+        """
+        lo = bisect.bisect_right(self.zone_start_m, pos_m) - 1
+        hi = bisect.bisect_right(self.zone_start_m, pos_m + lookahead_m)
+        return min(self.zone_limit_mps[max(lo, 0) : max(hi, 1)])
+
+
+def _lane_lengths(root: ET.Element) -> dict[str, tuple[float, float]]:
+    out: dict[str, tuple[float, float]] = {}
+    for edge in root.iter("edge"):
+        for lane in edge.iter("lane"):
+            out[lane.attrib["id"]] = (float(lane.attrib["length"]), float(lane.attrib["speed"]))
+    return out
+
+
+def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGeometry:
+    """Read the ego route's geometry from a network file.
+
+    Raises:
+        ValueError: if the route is not drivable in the network.
+    """
+    root = ET.parse(net_file).getroot()
+    lanes = _lane_lengths(root)
+    edge_lane: dict[str, str] = {}
+    for edge in root.iter("edge"):
+        if edge.get("function"):
+            continue
+        for lane in edge.iter("lane"):
+            if "pedestrian" not in (lane.get("allow") or "").split():
+                edge_lane[edge.attrib["id"]] = lane.attrib["id"]  # the vehicle lane
+    conns: dict[tuple[str, str], ET.Element] = {}
+    via_next: dict[str, str] = {}
+    for c in root.iter("connection"):
+        src, dst = c.attrib["from"], c.attrib["to"]
+        if src.startswith(":"):
+            if c.get("via"):
+                via_next[f"{src}_{c.attrib['fromLane']}"] = c.attrib["via"]
+            continue
+        if dst in edge_lane and c.get("via"):
+            lane_from = f"{src}_{c.attrib['fromLane']}"
+            if lane_from == edge_lane.get(src):
+                conns[(src, dst)] = c
+
+    starts: list[float] = []
+    zone_start: list[float] = []
+    zone_limit: list[float] = []
+    pos = 0.0
+    end_of_edge: dict[str, float] = {}
+    for i, eid in enumerate(route_edges):
+        if eid not in edge_lane:
+            raise ValueError(f"route edge {eid!r} not found in {net_file}")
+        length, speed = lanes[edge_lane[eid]]
+        starts.append(pos)
+        if not zone_limit or zone_limit[-1] != speed:
+            zone_start.append(pos)
+            zone_limit.append(speed)
+        pos += length
+        end_of_edge[eid] = pos
+        if i + 1 < len(route_edges):
+            conn = conns.get((eid, route_edges[i + 1]))
+            if conn is None:
+                raise ValueError(f"no connection {eid} -> {route_edges[i + 1]} in {net_file}")
+            via: str | None = conn.attrib["via"]
+            nxt_speed = lanes[edge_lane[route_edges[i + 1]]][1]
+            if nxt_speed < speed:  # the lower limit starts at the junction
+                zone_start.append(pos)
+                zone_limit.append(nxt_speed)
+            while via:
+                pos += lanes[via][0]
+                via = via_next.get(via)
+
+    lights = []
+    crossings = []
+    nodes = {j.attrib["id"]: j for j in root.iter("junction")}
+    edge_to = {e.attrib["id"]: e.get("to") for e in root.iter("edge") if not e.get("function")}
+    for eid in route_edges[:-1]:
+        node = nodes[edge_to[eid] or ""]
+        if node.get("type") == "traffic_light":
+            lights.append(RouteLight(tls_id=node.attrib["id"], stop_line_m=end_of_edge[eid]))
+    for edge in root.iter("edge"):
+        if edge.get("function") != "crossing":
+            continue
+        crossed = set((edge.get("crossingEdges") or "").split())
+        cid = edge.attrib["id"]
+        node_id = cid[1:].rsplit("_", 1)[0]
+        route_in = [
+            e for e in route_edges[:-1] if edge_to[e] == node_id
+        ]
+        if not crossed & set(route_edges) or not route_in:
+            continue
+        walk = sorted(
+            {c.attrib["from"] for c in root.iter("connection") if c.attrib["to"] == cid}
+            | {c.attrib["to"] for c in root.iter("connection") if c.attrib["from"] == cid}
+        )
+        crossings.append(
+            RouteCrossing(
+                crossing_edge=cid,
+                walkingareas=tuple(walk),
+                stop_line_m=end_of_edge[route_in[0]],
+                signalized=nodes[node_id].get("type") == "traffic_light",
+            )
+        )
+    crossings.sort(key=lambda c: c.stop_line_m)
+    return RouteGeometry(
+        edges=tuple(route_edges),
+        edge_start_m=tuple(starts),
+        length_m=pos,
+        zone_start_m=tuple(zone_start),
+        zone_limit_mps=tuple(zone_limit),
+        lights=tuple(lights),
+        crossings=tuple(crossings),
+    )

@@ -1,0 +1,132 @@
+"""Build the urban network with SUMO's own tools.
+
+Writes plain XML (nodes, edges, connections with crossings) from
+:mod:`explaindrive.sim.scenario.layout` and runs ``netconvert`` on it. The
+generated ``urban.net.xml`` is committed with the package, so running the
+scenario never needs ``netconvert``; rebuild with ``explaindrive scenario build``.
+"""
+
+from __future__ import annotations
+
+import logging
+import subprocess
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+from explaindrive.sim.scenario import layout
+from explaindrive.sim.sumo_home import sumo_binary
+
+log = logging.getLogger(__name__)
+
+NODES_FILE = "urban.nod.xml"
+EDGES_FILE = "urban.edg.xml"
+CONNECTIONS_FILE = "urban.con.xml"
+NET_FILE = "urban.net.xml"
+
+
+def _attrs(**kwargs: object) -> str:
+    return " ".join(f"{k}={quoteattr(str(v))}" for k, v in kwargs.items())
+
+
+def nodes_xml() -> str:
+    """Plain node XML of the layout."""
+    lines = ['<nodes version="1.20">']
+    for n in layout.NODES:
+        lines.append(f"    <node {_attrs(id=n.id, x=n.x, y=n.y, type=n.type)}/>")
+    lines.append("</nodes>")
+    return "\n".join(lines) + "\n"
+
+
+def edges_xml() -> str:
+    """Plain edge XML: one edge per direction; streets get a vehicle lane and a sidewalk."""
+    lines = ['<edges version="1.20">']
+    for road in layout.ROADS:
+        for eid, a, b in ((road.forward, road.a, road.b), (road.backward, road.b, road.a)):
+            if road.kind == "footpath":
+                attrs = _attrs(
+                    id=eid, **{"from": a}, to=b, numLanes=1, speed=f"{road.speed_mps:.4f}",
+                    allow="pedestrian", width=layout.SIDEWALK_WIDTH_M,
+                )
+            else:
+                attrs = _attrs(
+                    id=eid, **{"from": a}, to=b, numLanes=1, speed=f"{road.speed_mps:.4f}",
+                    priority=2 if road.a in layout.EGO_ROUTE_NODES else 1,
+                    sidewalkWidth=layout.SIDEWALK_WIDTH_M,
+                )
+            lines.append(f"    <edge {attrs}/>")
+    lines.append("</edges>")
+    return "\n".join(lines) + "\n"
+
+
+def connections_xml() -> str:
+    """Plain connection XML holding the pedestrian crossings."""
+    lines = ['<connections version="1.20">']
+    for node, edges in layout.CROSSINGS:
+        signalized = any(n.id == node and n.type == "traffic_light" for n in layout.NODES)
+        attrs = _attrs(
+            node=node, edges=" ".join(edges), priority="true", width=4.0,
+        )
+        note = "signalized" if signalized else "zebra"
+        lines.append(f"    <crossing {attrs}/> <!-- {note} -->")
+    lines.append("</connections>")
+    return "\n".join(lines) + "\n"
+
+
+def write_plain_xml(out_dir: Path) -> dict[str, Path]:
+    """Write the plain node/edge/connection files into ``out_dir``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    files = {
+        "nodes": out_dir / NODES_FILE,
+        "edges": out_dir / EDGES_FILE,
+        "connections": out_dir / CONNECTIONS_FILE,
+    }
+    files["nodes"].write_text(nodes_xml())
+    files["edges"].write_text(edges_xml())
+    files["connections"].write_text(connections_xml())
+    return files
+
+
+def netconvert_args(files: dict[str, Path], net_file: Path) -> list[str]:
+    """Command line for netconvert."""
+    return [
+        sumo_binary("netconvert"),
+        "--node-files", str(files["nodes"]),
+        "--edge-files", str(files["edges"]),
+        "--connection-files", str(files["connections"]),
+        "--output-file", str(net_file),
+        "--no-turnarounds", "true",
+        "--tls.default-type", "static",
+        "--tls.cycle.time", str(layout.TLS_CYCLE_S),
+        "--tls.yellow.time", str(layout.TLS_YELLOW_S),
+        "--tls.left-green.time", "0",
+        "--walkingareas", "true",
+        "--junctions.corner-detail", "5",
+        "--no-warnings", "true",
+        "--output.street-names", "false",
+    ]
+
+
+def build_network(out_dir: Path) -> Path:
+    """Write the plain XML and run netconvert; returns the network file.
+
+    Raises:
+        RuntimeError: if netconvert fails (its stderr is included).
+    """
+    files = write_plain_xml(out_dir)
+    net_file = out_dir / NET_FILE
+    args = netconvert_args(files, net_file)
+    log.info("running %s", " ".join(args))
+    proc = subprocess.run(args, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        raise RuntimeError(f"netconvert failed ({proc.returncode}):\n{proc.stderr}")
+    _apply_offset(net_file, "J2", layout.TLS_OFFSET_J2_S)
+    return net_file
+
+
+def _apply_offset(net_file: Path, tls_id: str, offset_s: int) -> None:
+    """Set the offset of one static program in the generated network."""
+    text = net_file.read_text()
+    marker = f'<tlLogic id="{tls_id}" type="static" programID="0" offset="0">'
+    if marker not in text:
+        raise RuntimeError(f"traffic light {tls_id!r} not found in {net_file}")
+    net_file.write_text(text.replace(marker, marker.replace('offset="0"', f'offset="{offset_s}"')))
