@@ -34,6 +34,7 @@ from explaindrive.env.reward import (
     time_to_collision,
 )
 from explaindrive.sim.connection import SumoConnection
+from explaindrive.sim.pedestrians import PedestrianSource
 from explaindrive.sim.route import RouteGeometry, load_route_geometry
 from explaindrive.sim.scenario.files import (
     EGO_ID,
@@ -74,6 +75,7 @@ class _Episode:
     light_state: dict[str, S.LightState] = field(default_factory=dict)
     occupied: dict[str, bool] = field(default_factory=dict)
     done: bool = False
+    pedestrians: PedestrianSource | None = None
 
 
 class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
@@ -174,7 +176,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             self.close()
             raise
         schedule = list(opts.command_schedule)
-        self._ep = _Episode(command=opts.command, schedule=schedule, start_pos_m=start_pos)
+        self._ep = _Episode(
+            command=opts.command,
+            schedule=schedule,
+            start_pos_m=start_pos,
+            pedestrians=PedestrianSource(int(sumo_seed), horizon_s=self.config.max_steps + 1.0),
+        )
         self._apply_schedule(0.0)
         self._ep.pos_m = start_pos
         obs, _leader, _ = self._observe()
@@ -203,6 +210,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         v_new = max(0.0, ep.speed_mps + change)
         try:
             api.vehicle.setSpeed(EGO_ID, v_new)
+            if ep.pedestrians is not None:
+                ep.pedestrians.step(api, ep.steps * STEP_LENGTH_S)
             api.simulationStep()
         except BaseException:
             self.close()
@@ -313,6 +322,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         return self.scenario.state_dir() / f"level{level:g}_seed{seed}_w{self.config.warmup_s}.xml"
 
     def _restore_warm_state(self, level: float, seed: int) -> None:
+        """Continue from the cached warm-up state of (level, seed), creating it if needed."""
         api = self._conn.api
         path = self._state_file(level, seed)
         if not path.exists():
@@ -323,7 +333,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             os.close(fd)
             api.simulation.saveState(tmp)
             os.replace(tmp, path)
-        # Always continue from the saved file so that a fresh and a cached run agree.
+            # Restart so that a fresh and a cached run go through the same steps.
+            api.load(self._sumo_args(level, seed))
         api.simulation.loadState(str(path))
 
     def _insert_ego(self) -> float:

@@ -35,10 +35,10 @@ def _fmt(x: float) -> str:
 
 
 def routes_xml(traffic_level: float) -> str:
-    """Demand at a traffic level: vehicle flows (Poisson arrivals), pedestrians, the ego route.
+    """Vehicle demand at a traffic level: flows with Poisson arrivals and the ego route.
 
-    Vehicle flows scale with the level; level 1.0 puts 900 veh/h on the
-    ego's main road. Pedestrian flows do not depend on the level.
+    Flows scale with the level; level 1.0 puts 900 veh/h on the ego's main road.
+    Pedestrians are added by :class:`explaindrive.sim.pedestrians.PedestrianSource`.
     """
     level = layout.validate_traffic_level(traffic_level)
     lines = ["<routes>"]
@@ -67,17 +67,6 @@ def routes_xml(traffic_level: float) -> str:
         lines.append(f"    <flow {attr_text}>")
         lines.append(f'        <route edges="{" ".join(flow.edges)}"/>')
         lines.append("    </flow>")
-    for ped in layout.PEDESTRIAN_FLOWS:
-        rate = ped.persons_per_hour / 3600.0  # [1/s]
-        lines.append(
-            f'    <personFlow id="{ped.id}" begin="0" end="{FLOW_END_S}" '
-            f'period="exp({_fmt(rate)})" departPos="{_fmt(ped.depart_pos_m)}">'
-        )
-        lines.append(
-            f'        <walk from="{ped.from_edge}" to="{ped.to_edge}" '
-            f'arrivalPos="{_fmt(ped.arrival_pos_m)}"/>'
-        )
-        lines.append("    </personFlow>")
     lines.append("</routes>")
     return "\n".join(lines) + "\n"
 
