@@ -1,0 +1,146 @@
+"""Per-episode evaluation metrics: the one place that defines them.
+
+The paper reports, per episode: SUMO steps, mean speed, average time headway
+(TH), average time to collision (TTC), average jerk and AV collisions. We add
+red-light runs, pedestrian-yield violations, speed-limit violations, stop
+latency and travel time. Feed every ``info`` from ``env.step`` to
+:meth:`EpisodeMetrics.update`, then read :meth:`EpisodeMetrics.result`.
+
+Definitions:
+    mean speed   mean of the ego speed over all steps [m/s]
+    avg TH       mean time headway to the real leader, over steps with a real
+                 leader in range and the ego moving [s]
+    avg TTC      mean TTC to the real leader over the interaction steps: the ego
+                 closes in on it and TTC < TTC_INTERACTION_S (10 s); larger
+                 TTCs mean no conflict and would swamp the mean [s]
+    avg jerk     mean of |jerk| over all steps [m/s^3]
+    stop latency for each switch to STOP: steps until the speed reaches 0
+    travel time  seconds until the ego left the route (None if it did not)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+TTC_INTERACTION_S = 10.0  # [s] TTCs at or above this are not counted as interactions
+
+
+@dataclass(frozen=True, slots=True)
+class EpisodeResult:
+    """Figures of one episode."""
+
+    steps: int
+    mean_speed_mps: float
+    avg_headway_s: float | None
+    avg_ttc_s: float | None
+    avg_jerk_mps3: float
+    collisions: int
+    red_light_runs: int
+    ped_violations: int
+    speeding_steps: int
+    stop_latencies: tuple[int, ...]
+    unfinished_stops: int
+    distance_m: float
+    travel_time_s: float | None
+    total_reward: float
+
+    @property
+    def violations(self) -> int:
+        """Collisions plus every rule violation."""
+        return self.collisions + self.red_light_runs + self.ped_violations + self.speeding_steps
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        d = asdict(self)
+        d["stop_latencies"] = list(self.stop_latencies)
+        return d
+
+
+def _mean(values: list[float]) -> float | None:
+    return sum(values) / len(values) if values else None
+
+
+@dataclass(slots=True)
+class EpisodeMetrics:
+    """Accumulates step infos into an :class:`EpisodeResult`."""
+
+    speeds: list[float] = field(default_factory=list)
+    headways: list[float] = field(default_factory=list)
+    ttcs: list[float] = field(default_factory=list)
+    jerks: list[float] = field(default_factory=list)
+    collisions: int = 0
+    red_light_runs: int = 0
+    ped_violations: int = 0
+    speeding_steps: int = 0
+    stop_latencies: list[int] = field(default_factory=list)
+    _stop_open: int | None = None
+    distance_m: float = 0.0
+    time_s: float = 0.0
+    arrived: bool = False
+    total_reward: float = 0.0
+    _prev_command: str | None = None
+    _unfinished: int = 0
+
+    def update(self, info: dict[str, Any], reward: float = 0.0) -> None:
+        """Add one step's ``info`` (and reward)."""
+        speed = float(info["speed_mps"])
+        self.speeds.append(speed)
+        self.jerks.append(abs(float(info["jerk_mps3"])))
+        headway = float(info["real_headway_s"])
+        if math.isfinite(headway):
+            self.headways.append(headway)
+        ttc = float(info["real_ttc_s"])
+        if ttc < TTC_INTERACTION_S:
+            self.ttcs.append(ttc)
+        self.collisions += int(bool(info["collision"]))
+        self.red_light_runs += int(bool(info["red_light_run"]))
+        self.ped_violations += int(bool(info["ped_violation"]))
+        self.speeding_steps += int(bool(info["speeding"]))
+        self.distance_m = float(info["distance_m"])
+        self.time_s = float(info["time_s"])
+        self.arrived = self.arrived or bool(info.get("arrived", False))
+        self.total_reward += float(reward)
+        self._track_stop(str(info["command"]), speed)
+
+    def _track_stop(self, command: str, speed_mps: float) -> None:
+        # ``command`` is the command under which this step's action was taken.
+        if command == "stop" and self._prev_command != "stop":
+            self._stop_open = 0
+        if self._stop_open is not None:
+            if command != "stop":
+                self._stop_open = None  # cancelled before standstill; counted as unfinished
+                self._unfinished += 1
+            else:
+                self._stop_open += 1
+                if speed_mps <= 0.0:
+                    self.stop_latencies.append(self._stop_open)
+                    self._stop_open = None
+        self._prev_command = command
+
+    def result(self) -> EpisodeResult:
+        """The episode's figures."""
+        steps = len(self.speeds)
+        unfinished = self._unfinished + (1 if self._stop_open is not None else 0)
+        return EpisodeResult(
+            steps=steps,
+            mean_speed_mps=sum(self.speeds) / steps if steps else 0.0,
+            avg_headway_s=_mean(self.headways),
+            avg_ttc_s=_mean(self.ttcs),
+            avg_jerk_mps3=sum(self.jerks) / steps if steps else 0.0,
+            collisions=self.collisions,
+            red_light_runs=self.red_light_runs,
+            ped_violations=self.ped_violations,
+            speeding_steps=self.speeding_steps,
+            stop_latencies=tuple(self.stop_latencies),
+            unfinished_stops=unfinished,
+            distance_m=self.distance_m,
+            travel_time_s=self.time_s if self.arrived else None,
+            total_reward=self.total_reward,
+        )
+
+
+def stop_latency_bound(speed_mps: float) -> int:
+    """Steps allowed to reach 0 m/s after a stop command at ``speed_mps``: ceil(v/3) + 2."""
+    return math.ceil(speed_mps / 3.0) + 2
