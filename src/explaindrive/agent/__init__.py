@@ -1,0 +1,1 @@
+"""D3QN driving agents: network, replay, learner, training loop and the merged controller."""

@@ -1,0 +1,124 @@
+"""The merged driving controller: routes each passenger command to a trained policy.
+
+fast -> the fast agent; comfort -> the comfort agent; stop -> whichever of the two was
+active, fed ``cmd = 2`` (both agents are trained to obey stop). The shipped policies live
+in the package at ``explaindrive/agent/policies/{fast,comfort}.pt``, each with a JSON card.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from explaindrive.agent.checkpoint import CheckpointError, load_policy
+from explaindrive.agent.network import DuelingQNetwork
+from explaindrive.commands import Command
+from explaindrive.env.state import CMD, STATE_DIM
+
+log = logging.getLogger(__name__)
+
+SHIPPED_POLICIES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
+
+
+def shipped_policy_path(name: str) -> Path:
+    """Path of a shipped policy file (``fast`` or ``comfort``).
+
+    Raises:
+        ValueError: if ``name`` is not a shipped policy.
+    """
+    if name not in SHIPPED_POLICIES:
+        raise ValueError(f"no shipped policy {name!r}; expected one of {SHIPPED_POLICIES}")
+    root = importlib.resources.files("explaindrive.agent") / "policies" / f"{name}.pt"
+    return Path(str(root))
+
+
+@dataclass
+class QPolicy:
+    """A greedy policy over a trained Q-network; takes raw observations."""
+
+    network: DuelingQNetwork
+    card: dict[str, Any]
+
+    @classmethod
+    def load(cls, path: str | Path) -> QPolicy:
+        """Load ``path`` (``.pt``) and the card next to it (raises ``CheckpointError``)."""
+        net, card = load_policy(Path(path))
+        return cls(net, card)
+
+    @torch.no_grad()
+    def q_values(self, obs: np.ndarray) -> np.ndarray:
+        """Q-values of one raw observation, shape ``(n_actions,)``."""
+        x = torch.as_tensor(np.asarray(obs, dtype=np.float32)).reshape(1, STATE_DIM)
+        return self.network(x)[0].numpy()
+
+    def act(self, obs: np.ndarray) -> int:
+        """Greedy action of one raw observation."""
+        return int(np.argmax(self.q_values(obs)))
+
+
+class MergedController:
+    """Switches between the fast and comfort policies at runtime.
+
+    Args:
+        fast: the fast-driving policy.
+        comfort: the comfort-driving policy.
+        command: the initial command (stop starts on the fast agent).
+    """
+
+    def __init__(self, fast: QPolicy, comfort: QPolicy, command: Command | str = Command.FAST):
+        self.policies = {Command.FAST: fast, Command.COMFORT: comfort}
+        self.active_agent = Command.FAST
+        self.command = Command.FAST
+        self.set_command(command)
+
+    @classmethod
+    def from_files(cls, fast_path: str | Path, comfort_path: str | Path) -> MergedController:
+        """Controller over two policy files."""
+        return cls(QPolicy.load(fast_path), QPolicy.load(comfort_path))
+
+    @classmethod
+    def from_package(cls) -> MergedController:
+        """Controller over the policies shipped with the package.
+
+        Raises:
+            CheckpointError: naming the file, if a shipped policy is missing or corrupt.
+        """
+        paths = [shipped_policy_path(n) for n in SHIPPED_POLICIES]
+        for p in paths:
+            if not p.is_file():
+                raise CheckpointError(
+                    f"shipped policy not found: {p}; train one with "
+                    f"`explaindrive train --mode {p.stem}` and copy its policy.pt/.json there"
+                )
+        return cls.from_files(*paths)
+
+    def set_command(self, command: Command | str | int) -> None:
+        """Apply a passenger command; stop keeps the current agent."""
+        cmd = Command.parse(command)
+        if cmd is not Command.STOP:
+            self.active_agent = cmd
+        if cmd is not self.command:
+            log.debug("command %s -> %s (agent %s)", self.command.label, cmd.label,
+                      self.active_agent.label)  # fmt: skip
+        self.command = cmd
+
+    @property
+    def policy(self) -> QPolicy:
+        """The policy currently driving."""
+        return self.policies[self.active_agent]
+
+    def observation(self, obs: np.ndarray) -> np.ndarray:
+        """``obs`` with its ``cmd`` component set to the current command."""
+        x = np.array(obs, dtype=np.float32).reshape(STATE_DIM)
+        x[CMD] = float(self.command)
+        return x
+
+    def act(self, obs: np.ndarray) -> int:
+        """Action of the active agent for a raw observation under the current command."""
+        return self.policy.act(self.observation(obs))

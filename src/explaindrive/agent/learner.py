@@ -1,0 +1,120 @@
+"""The D3QN learner: online and target networks, optimiser, action selection, updates."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import numpy as np
+import torch
+
+from explaindrive.agent.buffer import ReplayBatch
+from explaindrive.agent.config import TrainConfig
+from explaindrive.agent.network import DuelingQNetwork
+from explaindrive.agent.targets import double_dqn_target, linear_schedule, td_loss
+from explaindrive.env.actions import N_ACTIONS
+
+
+class D3QNLearner:
+    """Dueling double DQN with a hard or Polyak-averaged target network.
+
+    Args:
+        config: the training config (network, optimiser and target settings).
+        seed: seeds the network initialisation (``config.seed`` when omitted).
+    """
+
+    def __init__(self, config: TrainConfig, seed: int | None = None) -> None:
+        self.config = config
+        torch.manual_seed(config.seed if seed is None else seed)
+        self.q = DuelingQNetwork(config.hidden_sizes)
+        self.q_target = copy.deepcopy(self.q)
+        self.q_target.requires_grad_(False)
+        self.optimizer = torch.optim.Adam(self.q.parameters(), lr=config.lr)
+        self.updates = 0
+
+    def epsilon(self, env_steps: int) -> float:
+        """Exploration rate after ``env_steps`` transitions (linear decay)."""
+        c = self.config
+        return linear_schedule(c.eps_start, c.eps_end, c.eps_decay_steps, env_steps)
+
+    def learning_rate(self, env_steps: int) -> float:
+        """Learning rate after ``env_steps`` transitions (constant unless ``lr_final`` is set)."""
+        c = self.config
+        if c.lr_final is None:
+            return c.lr
+        return linear_schedule(c.lr, c.lr_final, c.lr_decay_steps, env_steps)
+
+    @torch.no_grad()
+    def act(self, obs: np.ndarray, epsilon: float, rng: np.random.Generator) -> np.ndarray:
+        """Epsilon-greedy actions for a batch of raw observations, in one forward pass."""
+        obs = np.asarray(obs, dtype=np.float32).reshape(-1, self.q.state_dim)
+        greedy = self.q(torch.from_numpy(obs)).argmax(dim=-1).numpy()
+        explore = rng.random(len(obs)) < epsilon
+        random_actions = rng.integers(0, N_ACTIONS, size=len(obs))
+        return np.where(explore, random_actions, greedy).astype(np.int64)
+
+    def update(self, batch: ReplayBatch, env_steps: int) -> dict[str, float]:
+        """One gradient step on a minibatch; updates the target network when due.
+
+        Returns:
+            ``td_loss``, ``q_values`` (mean Q of the taken actions), ``learning_rate`` and
+            ``grad_norm`` (before clipping; 0 when clipping is off).
+        """
+        c = self.config
+        lr = self.learning_rate(env_steps)
+        for group in self.optimizer.param_groups:
+            group["lr"] = lr
+        obs = torch.from_numpy(batch.obs)
+        next_obs = torch.from_numpy(batch.next_obs)
+        actions = torch.from_numpy(batch.actions).long()
+        rewards = torch.from_numpy(batch.rewards)
+        terminated = torch.from_numpy(batch.terminated)
+
+        q_both = self.q(torch.cat([obs, next_obs]))  # one forward pass for s and s'
+        q_obs, next_online = q_both[: len(obs)], q_both[len(obs) :].detach()
+        with torch.no_grad():
+            next_target = self.q_target(next_obs)
+        target = double_dqn_target(rewards, terminated, next_online, next_target, c.gamma)
+        q_taken = q_obs.gather(1, actions.unsqueeze(1)).squeeze(1)
+        loss = td_loss(q_taken, target, c.loss, c.huber_delta)
+
+        self.optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        grad_norm = 0.0
+        if c.grad_clip_norm is not None:
+            grad_norm = float(torch.nn.utils.clip_grad_norm_(self.q.parameters(), c.grad_clip_norm))
+        self.optimizer.step()
+        self.updates += 1
+        if self.updates % c.target_update_interval == 0:
+            self.update_target(c.tau)
+        return {
+            "td_loss": float(loss.detach()),
+            "q_values": float(q_taken.detach().mean()),
+            "learning_rate": lr,
+            "grad_norm": grad_norm,
+        }
+
+    @torch.no_grad()
+    def update_target(self, tau: float) -> None:
+        """``target <- tau * online + (1 - tau) * target`` (tau = 1: hard copy)."""
+        for t, o in zip(self.q_target.parameters(), self.q.parameters(), strict=True):
+            if tau >= 1.0:
+                t.copy_(o)
+            else:
+                t.mul_(1.0 - tau).add_(o, alpha=tau)
+
+    def state_dict(self) -> dict[str, Any]:
+        """Everything needed to continue training (networks, optimiser, update count)."""
+        return {
+            "q": self.q.state_dict(),
+            "q_target": self.q_target.state_dict(),
+            "optimizer": self.optimizer.state_dict(),
+            "updates": self.updates,
+        }
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore :meth:`state_dict` (raises ``RuntimeError``/``KeyError`` on a mismatch)."""
+        self.q.load_state_dict(state["q"])
+        self.q_target.load_state_dict(state["q_target"])
+        self.optimizer.load_state_dict(state["optimizer"])
+        self.updates = int(state["updates"])

@@ -1,0 +1,81 @@
+"""The paper's training schedule of episodes: command, stop injections, traffic and seed.
+
+In even-numbered episodes the primary command (fast or comfort) is interleaved with stop
+commands at random intervals; in odd-numbered episodes it holds for the whole episode. The
+traffic level and the simulation seed vary per episode. Every plan is a pure function of
+the run seed and the episode index, so a resumed run replays the same episodes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from explaindrive.agent.config import TrainConfig
+from explaindrive.commands import Command
+
+
+@dataclass(frozen=True)
+class EpisodePlan:
+    """How one training episode is set up."""
+
+    index: int
+    seed: int
+    traffic_level: float
+    command: Command
+    command_schedule: tuple[tuple[float, str], ...]  # (time [s], command label) switches
+
+    @property
+    def has_stops(self) -> bool:
+        """Whether stop commands are injected in this episode."""
+        return bool(self.command_schedule)
+
+    def reset_options(self) -> dict[str, Any]:
+        """The ``options`` of ``env.reset`` for this episode."""
+        return {
+            "command": self.command.label,
+            "traffic_level": self.traffic_level,
+            "command_schedule": [list(s) for s in self.command_schedule],
+        }
+
+
+def stop_schedule(
+    rng: np.random.Generator,
+    primary: Command,
+    gap_s: tuple[float, float],
+    duration_s: tuple[float, float],
+    horizon_s: float,
+) -> tuple[tuple[float, str], ...]:
+    """Alternate ``primary`` with stop commands at random times up to ``horizon_s``.
+
+    Each cycle waits ``U(gap_s)`` seconds of the primary command, then holds stop for
+    ``U(duration_s)`` seconds. Times are rounded to whole seconds (the decision step).
+    """
+    switches: list[tuple[float, str]] = []
+    t = 0.0
+    while True:
+        t += max(1.0, round(float(rng.uniform(*gap_s))))
+        if t >= horizon_s:
+            break
+        switches.append((t, Command.STOP.label))
+        t += max(1.0, round(float(rng.uniform(*duration_s))))
+        switches.append((t, primary.label))
+    return tuple(switches)
+
+
+def plan_episode(config: TrainConfig, index: int) -> EpisodePlan:
+    """The plan of episode ``index`` (0-based; episode 0 is even) of a run."""
+    if index < 0:
+        raise ValueError(f"episode index must be >= 0, got {index}")
+    rng = np.random.default_rng([config.seed, index])
+    seed = int(rng.integers(0, 2**31 - 1))
+    level = float(config.traffic_levels[int(rng.integers(len(config.traffic_levels)))])
+    primary = config.command
+    schedule: tuple[tuple[float, str], ...] = ()
+    if index % 2 == 0:
+        schedule = stop_schedule(
+            rng, primary, config.stop_gap_s, config.stop_duration_s, config.schedule_horizon_s
+        )
+    return EpisodePlan(index, seed, level, primary, schedule)

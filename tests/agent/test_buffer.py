@@ -1,0 +1,59 @@
+"""The replay ring buffer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from explaindrive.agent.buffer import ReplayBuffer, replay_nbytes
+
+
+def _add(buf: ReplayBuffer, start: int, n: int) -> None:
+    ids = np.arange(start, start + n, dtype=np.float32)
+    obs = np.repeat(ids[:, None], 8, axis=1)
+    buf.add(obs, ids.astype(np.int64) % 7, ids, obs + 0.5, ids % 2 == 0)
+
+
+def test_ring_overwrites_the_oldest() -> None:
+    buf = ReplayBuffer(4)
+    _add(buf, 0, 3)
+    assert (len(buf), buf.pos) == (3, 3)
+    _add(buf, 3, 3)  # items 3, 4, 5 -> slots 3, 0, 1
+    assert (len(buf), buf.pos) == (4, 2)
+    assert buf.obs[:, 0].tolist() == [4.0, 5.0, 2.0, 3.0]
+    assert buf.next_obs[:, 0].tolist() == [4.5, 5.5, 2.5, 3.5]
+    assert buf.rewards.tolist() == [4.0, 5.0, 2.0, 3.0]
+    assert buf.terminated.tolist() == [True, False, True, False]
+    with pytest.raises(ValueError, match="cannot add 5"):
+        _add(buf, 0, 5)
+
+
+def test_sample_returns_consistent_rows() -> None:
+    buf = ReplayBuffer(10)
+    _add(buf, 0, 6)
+    batch = buf.sample(32, np.random.default_rng(0))
+    assert batch.obs.shape == (32, 8) and batch.actions.dtype == np.int64
+    assert set(batch.rewards.tolist()) <= {0.0, 1.0, 2.0, 3.0, 4.0, 5.0}
+    assert np.array_equal(batch.obs[:, 0], batch.rewards)
+    assert np.array_equal(batch.next_obs[:, 0], batch.rewards + 0.5)
+    with pytest.raises(ValueError, match="empty"):
+        ReplayBuffer(3).sample(1, np.random.default_rng(0))
+
+
+def test_paper_capacity_fits_well_under_one_gigabyte() -> None:
+    # 5M x (2 x 8 x 4 B states + 1 B action + 4 B reward + 1 B flag) = 350 MB
+    assert replay_nbytes(5_000_000) == 350_000_000
+    buf = ReplayBuffer(5_000_000)  # np.zeros: pages are only committed when written
+    assert buf.nbytes == 350_000_000 < 1 << 30
+
+
+def test_state_dict_round_trip() -> None:
+    buf = ReplayBuffer(4)
+    _add(buf, 0, 3)
+    _add(buf, 3, 3)
+    other = ReplayBuffer(4)
+    other.load_state_dict(buf.state_dict())
+    assert (len(other), other.pos) == (4, 2)
+    assert np.array_equal(other.obs, buf.obs) and np.array_equal(other.actions, buf.actions)
+    with pytest.raises(ValueError, match="capacity 4"):
+        ReplayBuffer(8).load_state_dict(buf.state_dict())

@@ -1,0 +1,73 @@
+"""Network, learner updates, target updates and action selection."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from explaindrive.agent.buffer import ReplayBuffer
+from explaindrive.agent.config import PAPER
+from explaindrive.agent.learner import D3QNLearner
+from explaindrive.agent.network import DuelingQNetwork
+from explaindrive.agent.targets import dueling_aggregate
+from explaindrive.env.state import normalize
+
+
+def test_network_normalises_raw_observations_itself() -> None:
+    torch.manual_seed(0)
+    net = DuelingQNetwork((16, 16))
+    raw = np.array([[1, 8.0, 13.9, 45.0, -2.0, 120.0, 2, 200.0]], dtype=np.float32)
+    features = net.trunk(torch.from_numpy(normalize(raw)))
+    manual = dueling_aggregate(net.value(features), net.advantage(features))
+    assert torch.allclose(net(torch.from_numpy(raw)), manual)
+    assert net(torch.from_numpy(raw)).shape == (1, 7)
+    assert int(net.greedy(raw[0])) == int(manual.argmax())
+    with pytest.raises(ValueError, match="hidden_sizes"):
+        DuelingQNetwork((0,))
+
+
+def test_soft_and_hard_target_updates() -> None:
+    learner = D3QNLearner(PAPER.replace(hidden_sizes=[4]))
+    with torch.no_grad():
+        for p in learner.q.parameters():
+            p.fill_(1.0)
+        for p in learner.q_target.parameters():
+            p.fill_(0.0)
+    learner.update_target(0.1)
+    learner.update_target(0.1)  # 0.1, then 0.9 * 0.1 + 0.1 = 0.19
+    assert all(torch.allclose(p, torch.full_like(p, 0.19)) for p in learner.q_target.parameters())
+    learner.update_target(1.0)
+    assert all(torch.equal(p, torch.ones_like(p)) for p in learner.q_target.parameters())
+
+
+def test_epsilon_greedy_batch() -> None:
+    learner = D3QNLearner(PAPER.replace(eps_start=1.0, eps_end=0.1, eps_decay_steps=100))
+    assert learner.epsilon(50) == pytest.approx(0.55)
+    obs = np.zeros((500, 8), dtype=np.float32)
+    rng = np.random.default_rng(0)
+    greedy = learner.act(obs, 0.0, rng)
+    assert len(set(greedy.tolist())) == 1  # same state -> same greedy action
+    random = learner.act(obs, 1.0, rng)
+    assert set(random.tolist()) == set(range(7))
+
+
+def test_learning_rate_schedule() -> None:
+    learner = D3QNLearner(PAPER.replace(lr=1e-3, lr_final=1e-4, lr_decay_steps=1000))
+    assert learner.learning_rate(500) == pytest.approx(5.5e-4)
+    assert D3QNLearner(PAPER).learning_rate(10**9) == pytest.approx(1e-3)
+
+
+def test_learner_learns_a_contextual_bandit() -> None:
+    """Reward 1 for action 6 only, every transition terminal: greedy must become 6."""
+    cfg = PAPER.replace(hidden_sizes=[32, 32], lr=1e-2, batch_size=64, target_update_interval=10)
+    learner = D3QNLearner(cfg)
+    rng = np.random.default_rng(0)
+    buf = ReplayBuffer(2000)
+    obs = rng.uniform(0, 1, (2000, 8)).astype(np.float32) * np.float32(20)
+    actions = rng.integers(0, 7, 2000)
+    buf.add(obs, actions, (actions == 6).astype(np.float32), obs, np.ones(2000, bool))
+    losses = [learner.update(buf.sample(64, rng), 0)["td_loss"] for _ in range(300)]
+    assert np.mean(losses[-20:]) < 0.1 * np.mean(losses[:20])
+    assert (learner.act(obs[:100], 0.0, rng) == 6).all()
+    assert learner.updates == 300

@@ -1,0 +1,37 @@
+"""The paper's episode schedule."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from explaindrive.agent.config import PAPER
+from explaindrive.agent.schedule import plan_episode, stop_schedule
+from explaindrive.commands import Command
+
+
+def test_even_episodes_interleave_stop_odd_hold_the_primary() -> None:
+    cfg = PAPER.replace(mode="comfort")
+    even, odd = plan_episode(cfg, 10), plan_episode(cfg, 11)
+    assert even.has_stops and not odd.has_stops
+    labels = [c for _, c in even.command_schedule]
+    assert labels[0::2] == ["stop"] * len(labels[0::2])
+    assert labels[1::2] == ["comfort"] * len(labels[1::2])
+    times = [t for t, _ in even.command_schedule]
+    assert times == sorted(times) and times[0] >= cfg.stop_gap_s[0]
+    assert odd.reset_options() == {
+        "command": "comfort", "traffic_level": odd.traffic_level, "command_schedule": []
+    }  # fmt: skip
+
+
+def test_plans_are_reproducible_and_vary() -> None:
+    assert plan_episode(PAPER, 4) == plan_episode(PAPER, 4)
+    plans = [plan_episode(PAPER, i) for i in range(40)]
+    assert len({p.seed for p in plans}) == 40
+    assert {p.traffic_level for p in plans} == set(PAPER.traffic_levels)
+    assert plan_episode(PAPER.replace(seed=1), 4).seed != plan_episode(PAPER, 4).seed
+
+
+def test_stop_schedule_gaps_and_durations() -> None:
+    sched = stop_schedule(np.random.default_rng(0), Command.FAST, (10, 10), (4, 4), 40.0)
+    assert sched == ((10.0, "stop"), (14.0, "fast"), (24.0, "stop"), (28.0, "fast"),
+                     (38.0, "stop"), (42.0, "fast"))  # fmt: skip

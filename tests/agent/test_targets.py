@@ -1,0 +1,56 @@
+"""The pure D3QN functions against numbers computed by hand."""
+
+from __future__ import annotations
+
+import pytest
+import torch
+
+from explaindrive.agent.targets import (
+    double_dqn_target,
+    dueling_aggregate,
+    linear_schedule,
+    td_loss,
+)
+
+
+def test_dueling_aggregate_subtracts_the_mean_advantage() -> None:
+    value = torch.tensor([[1.0], [-2.0]])
+    adv = torch.tensor([[1.0, 2.0, 3.0], [0.0, 0.0, 6.0]])
+    # mean advantages 2 and 2: Q = V + A - 2
+    expected = torch.tensor([[0.0, 1.0, 2.0], [-4.0, -4.0, 2.0]])
+    assert torch.equal(dueling_aggregate(value, adv), expected)
+    assert torch.equal(dueling_aggregate(value.squeeze(1), adv), expected)
+
+
+def test_double_dqn_target_selects_online_and_evaluates_target() -> None:
+    rewards = torch.tensor([1.0, 0.5, -1.0])
+    terminated = torch.tensor([False, True, False])
+    next_online = torch.tensor([[1.0, 3.0, 2.0], [5.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    next_target = torch.tensor([[10.0, 20.0, 30.0], [7.0, 8.0, 9.0], [4.0, 5.0, 6.0]])
+    target = double_dqn_target(rewards, terminated, next_online, next_target, gamma=0.9)
+    # argmax online = (1, 0, 2) -> target Q (20, 7, 6); the second is terminal.
+    assert torch.allclose(target, torch.tensor([1.0 + 0.9 * 20.0, 0.5, -1.0 + 0.9 * 6.0]))
+    # the plain DQN max over the target net would give 1 + 0.9 * 30 for the first one
+    assert target[0].item() != pytest.approx(28.0)
+
+
+def test_double_dqn_target_has_no_gradient() -> None:
+    online = torch.ones(2, 3, requires_grad=True)
+    target = double_dqn_target(torch.zeros(2), torch.zeros(2), online, online * 2, 0.99)
+    assert not target.requires_grad
+
+
+def test_td_losses() -> None:
+    q = torch.tensor([1.0, 2.0])
+    y = torch.tensor([0.0, 5.0])
+    assert td_loss(q, y, "mse").item() == pytest.approx((1.0 + 9.0) / 2)
+    # huber, delta 1: 0.5 * 1^2 and 1 * (3 - 0.5)
+    assert td_loss(q, y, "huber", 1.0).item() == pytest.approx((0.5 + 2.5) / 2)
+    with pytest.raises(ValueError, match="unknown TD loss"):
+        td_loss(q, y, "l1")
+
+
+def test_linear_schedule() -> None:
+    assert linear_schedule(1.0, 0.1, 100, 0) == pytest.approx(1.0)
+    assert linear_schedule(1.0, 0.1, 100, 50) == pytest.approx(0.55)
+    assert linear_schedule(1.0, 0.1, 100, 500) == pytest.approx(0.1)
