@@ -1,0 +1,39 @@
+"""Shared fixtures: a private cache for generated SUMO files, and env construction."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterator
+
+import pytest
+
+from explaindrive.env.urban_drive import UrbanDriveEnv
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """Keep generated demand files and warm-up states out of the user's cache."""
+    old = os.environ.get("EXPLAINDRIVE_CACHE")
+    os.environ["EXPLAINDRIVE_CACHE"] = str(tmp_path_factory.mktemp("explaindrive-cache"))
+    yield
+    if old is None:
+        os.environ.pop("EXPLAINDRIVE_CACHE", None)
+    else:
+        os.environ["EXPLAINDRIVE_CACHE"] = old
+
+
+@pytest.fixture
+def make_env() -> Iterator[Callable[..., UrbanDriveEnv]]:
+    """Build envs and close them all after the test (libsumo: one running at a time)."""
+    made: list[UrbanDriveEnv] = []
+
+    def factory(**kwargs: object) -> UrbanDriveEnv:
+        for env in made:
+            env.close()
+        env = UrbanDriveEnv(**kwargs)  # type: ignore[arg-type]
+        made.append(env)
+        return env
+
+    yield factory
+    for env in made:
+        env.close()

@@ -1,0 +1,55 @@
+"""Episode metrics against hand-computed numbers."""
+
+import math
+
+import pytest
+
+from explaindrive.env.metrics import EpisodeMetrics, stop_latency_bound
+
+
+def info(speed, command="fast", *, headway=math.inf, ttc=math.inf, jerk=0.0, dist=0.0, t=0.0,
+         collision=False, red=False, ped=False, speeding=False, arrived=False):
+    return {
+        "speed_mps": speed, "command": command, "real_headway_s": headway, "real_ttc_s": ttc,
+        "jerk_mps3": jerk, "distance_m": dist, "time_s": t, "collision": collision,
+        "red_light_run": red, "ped_violation": ped, "speeding": speeding, "arrived": arrived,
+    }
+
+
+def test_episode_figures():
+    m = EpisodeMetrics()
+    m.update(info(3.0, headway=2.0, ttc=4.0, jerk=3.0, dist=3, t=1), reward=1.0)
+    m.update(info(6.0, headway=4.0, ttc=12.0, jerk=0.0, dist=9, t=2), reward=2.0)
+    m.update(info(6.0, jerk=-3.0, dist=15, t=3, speeding=True, red=True), reward=-10.0)
+    m.update(info(9.0, ttc=2.0, jerk=3.0, dist=24, t=4, arrived=True), reward=0.5)
+    r = m.result()
+    assert r.steps == 4
+    assert r.mean_speed_mps == 6.0  # (3 + 6 + 6 + 9) / 4
+    assert r.avg_headway_s == 3.0  # (2 + 4) / 2, steps without a leader skipped
+    assert r.avg_ttc_s == 3.0  # (4 + 2) / 2; 12 s is no interaction (>= 10 s)
+    assert r.avg_jerk_mps3 == 2.25  # (3 + 0 + 3 + 3) / 4
+    assert (r.collisions, r.red_light_runs, r.ped_violations, r.speeding_steps) == (0, 1, 0, 1)
+    assert r.violations == 2
+    assert r.travel_time_s == 4.0 and r.distance_m == 24.0
+    assert r.total_reward == pytest.approx(-6.5)
+
+
+def test_stop_latency_counts_steps_to_standstill():
+    m = EpisodeMetrics()
+    for speed, cmd in [(9, "fast"), (6, "stop"), (3, "stop"), (0, "stop"), (0, "stop"),
+                       (2, "fast"), (1, "stop"), (1, "comfort")]:
+        m.update(info(float(speed), cmd))
+    r = m.result()
+    assert r.stop_latencies == (3,)
+    assert r.unfinished_stops == 1  # the second stop was lifted before standstill
+    assert r.travel_time_s is None
+
+
+def test_empty_episode():
+    r = EpisodeMetrics().result()
+    assert (r.steps, r.mean_speed_mps, r.avg_headway_s, r.avg_ttc_s) == (0, 0.0, None, None)
+
+
+@pytest.mark.parametrize(("speed", "bound"), [(0.0, 2), (3.0, 3), (13.0, 7), (13.89, 7)])
+def test_stop_latency_bound(speed, bound):
+    assert stop_latency_bound(speed) == bound

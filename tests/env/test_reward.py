@@ -1,0 +1,109 @@
+"""Each reward term against values computed by hand."""
+
+import math
+
+import pytest
+
+from explaindrive.commands import Command
+from explaindrive.env import reward as R
+
+
+def test_constants_match_the_paper():
+    assert (R.R_RESPECT, R.R_UNSAFE, R.R_CRITICAL) == (2.0, 10.0, 50.0)
+    assert (R.HEADWAY_MU, R.HEADWAY_SIGMA) == (0.4226, 0.4365)
+    assert R.TTC_THRESHOLD_S == 2.0
+
+
+@pytest.mark.parametrize(
+    ("ttc", "expected"),
+    [
+        (1.0, math.log(0.5)),  # -0.693147
+        (0.5, math.log(0.25)),  # -1.386294
+        (2.0, 0.0),  # log(1)
+        (2.5, 0.0),  # above the threshold
+        (math.inf, 0.0),
+        (0.0, math.log(0.001 / 2.0)),  # floored: -7.600902
+    ],
+)
+def test_f_ttc(ttc, expected):
+    assert R.f_ttc(ttc) == pytest.approx(expected, abs=1e-9)
+
+
+def test_f_headway_is_the_lognormal_density():
+    # h = 1: z = (0 - 0.4226) / 0.4365 = -0.968156; exp(-z^2/2) = 0.625839;
+    # 1 / (1 * 0.4365 * sqrt(2 pi)) = 0.913957 -> 0.571990
+    assert R.f_headway(1.0) == pytest.approx(0.571990, abs=1e-6)
+    # h = 2: z = (0.693147 - 0.4226) / 0.4365 = 0.619810; exp(-z^2/2) = 0.825239;
+    # 1 / (2 * 0.4365 * sqrt(2 pi)) = 0.456979 -> 0.377116
+    assert R.f_headway(2.0) == pytest.approx(0.377116, abs=1e-6)
+    assert R.f_headway(math.inf) == 0.0
+    assert R.f_headway(0.0) == 0.0
+
+
+def test_ttc_and_headway_features():
+    assert R.time_to_collision(10.0, 5.0) == 2.0
+    assert R.time_to_collision(10.0, 0.0) == math.inf  # not closing in
+    assert R.time_to_collision(10.0, -2.0) == math.inf
+    assert R.time_headway(10.0, 5.0, 5.0) == 3.0  # (10 + 5) / 5
+    assert R.time_headway(10.0, 5.0, 0.0) == math.inf
+    assert R.jerk(2.0, -1.0) == 3.0
+
+
+def test_speed_reward():
+    assert R.speed_reward(14.0, 13.89, 3.0) == -10.0
+    assert R.speed_reward(6.945, 13.89, 3.0) == pytest.approx(1.5)
+    assert R.speed_reward(6.945, 13.89, 1.5) == pytest.approx(0.75)
+    assert R.speed_reward(0.0, 8.33, 3.0) == 0.0
+
+
+def test_traffic_rules_reward():
+    assert R.traffic_rules_reward(violation=True, stopped=False, stop_reason=None) == -10.0
+    assert R.traffic_rules_reward(violation=False, stopped=True, stop_reason="signal") == 2.0
+    assert R.traffic_rules_reward(violation=False, stopped=True, stop_reason="queue") == 0.0
+    assert R.traffic_rules_reward(violation=False, stopped=True, stop_reason=None) == -10.0
+    assert R.traffic_rules_reward(violation=False, stopped=False, stop_reason=None) == 0.0
+
+
+def test_stop_reward():
+    assert R.stop_reward(0.0, -3) == 2.0
+    assert R.stop_reward(0.0, 0) == 2.0  # standing still is respecting the stop
+    assert R.stop_reward(5.0, 0) == -50.0
+    assert R.stop_reward(5.0, 2) == -50.0
+    assert R.stop_reward(5.0, -1) == 0.0
+
+
+def _features(**kw):
+    base = dict(
+        speed_mps=10.0, speed_change_mps=1, limit_mps=13.89, ttc_s=1.0, headway_s=1.0,
+        jerk_mps3=2.0, violation=False, stop_reason=None, collided=False,
+    )
+    base.update(kw)
+    return R.StepFeatures(**base)
+
+
+def test_fast_reward_terms():
+    t = R.reward_terms(Command.FAST, _features())
+    assert t.ttc == pytest.approx(2 * -0.693147, abs=1e-6)
+    assert t.headway == pytest.approx(3 * 0.571990, abs=1e-5)
+    assert t.jerk == 0.0
+    assert t.speed == pytest.approx(3 * 10 / 13.89)
+    # -1.386294 + 1.715970 + 2.159827 = 2.489503
+    assert t.total == pytest.approx(2.489503, abs=1e-5)
+
+
+def test_comfort_reward_terms():
+    t = R.reward_terms(Command.COMFORT, _features(collided=True))
+    assert t.headway == pytest.approx(1.5 * 0.571990, abs=1e-5)
+    assert t.jerk == -4.0
+    assert t.speed == pytest.approx(1.5 * 10 / 13.89)
+    assert t.collision == -50.0
+    # -1.386294 + 0.857985 - 4 + 1.079914 - 50 = -53.448395
+    assert t.total == pytest.approx(-53.448395, abs=1e-5)
+
+
+def test_stop_reward_terms_only_hold_the_stop_term():
+    t = R.reward_terms(Command.STOP, _features(speed_change_mps=1))
+    assert t.as_dict() == {
+        "ttc": 0.0, "headway": 0.0, "jerk": 0.0, "traffic": 0.0, "speed": 0.0,
+        "collision": 0.0, "stop": -50.0, "total": -50.0,
+    }

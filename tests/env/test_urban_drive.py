@@ -1,0 +1,204 @@
+"""The driving environment against a live SUMO (libsumo)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import explaindrive
+from explaindrive.env import state as S
+from explaindrive.env.actions import action_index
+from explaindrive.env.config import EnvConfig
+from explaindrive.env.metrics import EpisodeMetrics
+from explaindrive.env.scripted import AlwaysAccelerate, CautiousDriver, ConstantSpeed
+from explaindrive.sim.connection import SumoConnection
+
+
+def run_episode(env, driver, seed, options=None, max_steps=2000):
+    obs, _ = env.reset(seed=seed, options=options)
+    observations, infos, rewards = [obs], [], []
+    metrics = EpisodeMetrics()
+    for _ in range(max_steps):
+        obs, reward, terminated, truncated, info = env.step(driver(obs))
+        observations.append(obs)
+        infos.append(info)
+        rewards.append(reward)
+        metrics.update(info, reward)
+        if terminated or truncated:
+            break
+    return np.array(observations), infos, rewards, metrics.result()
+
+
+def test_check_env_passes(make_env):
+    env = make_env()
+    check_env(env, skip_render_check=True)
+
+
+def test_registered_id_builds_the_env():
+    import gymnasium as gym
+
+    env = gym.make(explaindrive.ENV_ID, traffic_level=0.5)
+    try:
+        assert env.unwrapped.config.traffic_level == 0.5
+        obs, _ = env.reset(seed=0)
+        assert obs.shape == (8,)
+    finally:
+        env.close()
+
+
+def test_same_seed_same_episode(make_env):
+    env = make_env()
+    a, _, ra, _ = run_episode(env, CautiousDriver(), seed=21)
+    b, _, rb, _ = run_episode(env, CautiousDriver(), seed=21)
+    c, _, _, _ = run_episode(env, CautiousDriver(), seed=22)
+    assert a.shape == b.shape
+    np.testing.assert_array_equal(a, b)
+    assert ra == rb
+    assert a.shape != c.shape or not np.array_equal(a, c)
+
+
+def test_initial_observation(make_env):
+    env = make_env()
+    obs, info = env.reset(seed=3, options={"command": "comfort", "traffic_level": 0.5})
+    assert obs[S.CMD] == 1.0
+    assert obs[S.V_EGO] == 0.0
+    assert obs[S.V_LIM] == pytest.approx(50 / 3.6, abs=0.01)
+    assert info["traffic_level"] == 0.5
+    assert env.observation_space.contains(obs)
+
+
+def test_action_changes_speed_by_its_amount(make_env):
+    env = make_env(traffic_level=0.5)
+    env.reset(seed=1)
+    speeds = []
+    for change in (3, 2, -1, -3, -3):
+        obs, *_ = env.step(action_index(change))
+        speeds.append(float(obs[S.V_EGO]))
+    assert speeds == [3.0, 5.0, 4.0, 1.0, 0.0]  # clipped at 0
+
+
+def test_virtual_leader_on_red_and_for_pedestrians(make_env):
+    env = make_env(traffic_level=0.5)
+    seen_red = seen_ped = False
+    for seed in range(12):
+        obs_seq, infos, _, _ = run_episode(env, CautiousDriver(), seed=seed)
+        for obs, info in zip(obs_seq[1:], infos, strict=True):
+            real_gap = info["real_gap_m"]
+            if obs[S.TLS] == 2 and obs[S.D_TL] < min(real_gap, S.SENSOR_RANGE_M):
+                seen_red = True
+                assert obs[S.D_LEAD] == pytest.approx(obs[S.D_TL], abs=1e-3)
+                assert obs[S.DV] == pytest.approx(obs[S.V_EGO], abs=1e-3)  # leader speed 0
+            if obs[S.D_CROSS] < min(real_gap, obs[S.D_TL], S.SENSOR_RANGE_M):
+                seen_ped = True
+                assert obs[S.D_LEAD] == pytest.approx(obs[S.D_CROSS], abs=1e-3)
+        if seen_red and seen_ped:
+            break
+    assert seen_red and seen_ped
+
+
+def test_cautious_driver_breaks_no_rule(make_env):
+    env = make_env()
+    for seed in range(4):
+        _, infos, _, res = run_episode(env, CautiousDriver(), seed=seed)
+        assert infos[-1]["arrived"], f"seed {seed} did not finish"
+        assert res.violations == 0, (seed, res)
+        assert res.distance_m >= env.geometry.length_m - 10.0  # drove the whole route
+
+
+def test_reckless_drivers_are_caught(make_env):
+    env = make_env()
+    _, infos, rewards, res = run_episode(env, AlwaysAccelerate(), seed=0)
+    assert res.collisions + res.red_light_runs >= 1
+    assert res.speeding_steps >= 1
+    assert infos[-1]["collision"] and rewards[-1] <= -50.0
+    caught = 0
+    for seed in range(4):
+        _, _, _, res = run_episode(env, ConstantSpeed(8), seed=seed)
+        caught += res.collisions + res.red_light_runs + res.ped_violations
+    assert caught >= 1
+
+
+def test_command_schedule_and_set_command(make_env):
+    env = make_env(traffic_level=0.5)
+    obs, _ = env.reset(seed=4, options={"command_schedule": [(3, "stop"), (5, "comfort")]})
+    cmds = [obs[S.CMD]]
+    for _ in range(6):
+        obs, reward, *_ , info = env.step(action_index(1))
+        cmds.append(obs[S.CMD])
+    assert cmds == [0, 0, 0, 2, 2, 1, 1]
+    env.unwrapped.set_command("stop")
+    obs, reward, *_, info = env.step(action_index(1))
+    assert info["command"] == "stop" and reward == -50.0  # R2: speeding up under STOP
+
+
+def test_normalised_observations(make_env):
+    env = make_env(normalize_obs=True)
+    obs, _ = env.reset(seed=2)
+    assert np.all(np.abs(obs) <= 1.0)
+    assert env.observation_space.contains(obs)
+    np.testing.assert_allclose(S.denormalize(obs)[S.V_LIM], 50 / 3.6, atol=0.01)
+
+
+def test_info_carries_the_reward_terms(make_env):
+    env = make_env()
+    env.reset(seed=5)
+    _, reward, _, _, info = env.step(action_index(2))
+    terms = info["reward_terms"]
+    assert set(terms) == {"ttc", "headway", "jerk", "traffic", "speed", "collision", "stop", "total"}
+    assert terms["total"] == pytest.approx(reward)
+    assert terms["speed"] == pytest.approx(3 * 2 / (50 / 3.6), abs=1e-3)
+
+
+def test_route_geometry_matches_sumo(make_env):
+    env = make_env()
+    env.reset(seed=0)
+    api = env.sumo
+    ego_pos = env.geometry.edge_start_m[0] + api.vehicle.getLanePosition("ego")
+    for light in env.geometry.lights:
+        tls = {t[0]: t[2] for t in api.vehicle.getNextTLS("ego")}
+        assert light.stop_line_m - ego_pos == pytest.approx(tls[light.tls_id], abs=0.05)
+    last = env.geometry.edges[-1]
+    lane_len = api.lane.getLength(f"{last}_1")
+    assert env.geometry.length_m - ego_pos == pytest.approx(
+        api.vehicle.getDrivingDistance("ego", last, lane_len), abs=0.05
+    )
+
+
+@pytest.mark.parametrize("bad_action", [7, -1, 2.5])
+def test_bad_action_is_refused(make_env, bad_action):
+    env = make_env()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="outside the action space"):
+        env.step(bad_action)
+
+
+def test_bad_inputs_give_clear_errors(make_env, tmp_path):
+    env = make_env()
+    with pytest.raises(ValueError, match="unknown command 'turbo'"):
+        env.reset(seed=0, options={"command": "turbo"})
+    with pytest.raises(ValueError, match="unknown reset option"):
+        env.reset(seed=0, options={"trafic_level": 1.0})
+    with pytest.raises(ValueError, match="traffic level must be > 0"):
+        env.reset(seed=0, options={"traffic_level": 0})
+    with pytest.raises(ValueError, match="traffic level must be > 0"):
+        EnvConfig(traffic_level=-1.0)
+    with pytest.raises(ValueError, match="unknown env config key"):
+        make_env(config={"max_step": 10})
+    with pytest.raises(FileNotFoundError, match="network file not found"):
+        make_env(net_file=tmp_path / "missing.net.xml")
+    assert SumoConnection._libsumo_owner is None  # no SUMO left running
+    env = make_env()
+    env.reset(seed=0)  # and a new simulation starts fine
+    with pytest.raises(RuntimeError, match="reset"):
+        type(env)().step(0)
+
+
+def test_truncation_is_distinct_from_termination(make_env):
+    env = make_env(max_steps=5)
+    env.reset(seed=0)
+    for _ in range(5):
+        _, _, terminated, truncated, _ = env.step(action_index(0))
+    assert truncated and not terminated
+    with pytest.raises(RuntimeError, match="episode is over"):
+        env.step(action_index(0))
