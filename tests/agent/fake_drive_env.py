@@ -6,7 +6,7 @@ depends on the command active in the step, like the real env (fast / comfort / s
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
@@ -21,7 +21,7 @@ V_LIM_MPS = 10.0
 class FakeDriveEnv(gym.Env[np.ndarray, int]):
     """Fixed-length episodes (``max_steps``) unless ``route_m`` ends them earlier."""
 
-    metadata: dict[str, Any] = {"render_modes": []}
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
 
     def __init__(
         self, max_steps: int = 20, route_m: float | None = None, step_delay_s: float = 0.0

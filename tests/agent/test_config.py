@@ -39,7 +39,7 @@ def test_fast_preset_is_shorter_and_valid() -> None:
 def test_unknown_preset_and_key_are_rejected() -> None:
     with pytest.raises(ConfigError, match="unknown preset 'slow'"):
         preset("slow")
-    with pytest.raises(ConfigError, match="unknown config key.*lr_rate"):
+    with pytest.raises(ConfigError, match=r"unknown config key.*lr_rate"):
         TrainConfig.from_dict({"lr_rate": 0.1})
 
 

@@ -1,0 +1,147 @@
+"""The training loop on the fake env: outputs, checkpoint, resume, and a killed run."""
+
+from __future__ import annotations
+
+import csv
+import functools
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from explaindrive.agent.checkpoint import CheckpointError, load_checkpoint
+from explaindrive.agent.config import TrainConfig, preset
+from explaindrive.agent.controller import QPolicy
+from explaindrive.agent.trainer import moving_average, train
+from tests.agent.fake_drive_env import FakeDriveEnv
+
+EPISODE_STEPS = 20
+FACTORY = functools.partial(FakeDriveEnv, max_steps=EPISODE_STEPS)
+TINY = dict(
+    num_envs=1, hidden_sizes=[32, 32], buffer_size=5_000, batch_size=16, learning_starts=50,
+    train_frequency=2, target_update_interval=10, eps_decay_steps=150, checkpoint_every_episodes=4,
+    log_every_updates=10, stop_gap_s=[3, 5], stop_duration_s=[2, 3], schedule_horizon_s=20.0,
+    moving_average_window=3,
+)  # fmt: skip
+
+
+def tiny(**changes: object) -> TrainConfig:
+    return preset("fast").replace(**{**TINY, **changes})
+
+
+def rows(out: Path) -> list[dict[str, str]]:
+    with (out / "episodes.csv").open(newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_tiny_run_writes_every_output(tmp_path: Path) -> None:
+    result = train(tiny(episodes=10), tmp_path, env_factory=FACTORY)
+    # 10 fixed-length episodes; updates start at 50 transitions, one per 2:
+    # the calls at 50..200 transitions add 151 x 0.5 -> 75 updates.
+    assert (result.episodes, result.env_steps, result.updates) == (10, 200, 75)
+    table = rows(tmp_path)
+    assert [int(r["episode"]) for r in table] == list(range(10))
+    assert [int(r["stops"]) for r in table] == [1, 0] * 5
+    assert all(int(r["length"]) == EPISODE_STEPS and r["truncated"] == "1" for r in table)
+    assert [int(r["env_steps"]) for r in table] == [20 * (i + 1) for i in range(10)]
+    policy = QPolicy.load(result.policy_path)
+    assert policy.card["episodes"] == 10 and policy.card["env_steps"] == 200
+    assert policy.card["config"]["mode"] == "fast"
+    assert result.curve_path.stat().st_size > 1000
+    ckpt = load_checkpoint(tmp_path / "checkpoints")
+    assert ckpt.trainer["episodes_done"] == 10 and ckpt.replay is not None
+    assert ckpt.replay["obs"].shape == (200, 8)
+    assert json.loads((tmp_path / "checkpoints" / "config.json").read_text())["config"]["mode"] == "fast"
+
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    events = EventAccumulator(str(tmp_path / "tb"))
+    events.Reload()
+    tags = set(events.Tags()["scalars"])
+    assert {"charts/episodic_return", "charts/epsilon", "losses/td_loss"} <= tags
+    assert len(events.Scalars("charts/episodic_return")) == 10
+    assert len(events.Scalars("losses/td_loss")) == 7  # updates 10, 20, ..., 70
+
+
+def test_resume_continues_where_the_run_stopped(tmp_path: Path) -> None:
+    train(tiny(episodes=6), tmp_path, env_factory=FACTORY)
+    with pytest.raises(CheckpointError, match="already holds a training run"):
+        train(tiny(episodes=6), tmp_path, env_factory=FACTORY)
+    result = train(tiny(episodes=10), tmp_path, env_factory=FACTORY, resume=True)
+    assert (result.episodes, result.env_steps, result.updates) == (10, 200, 75)
+    assert [int(r["episode"]) for r in rows(tmp_path)] == list(range(10))
+
+
+def test_resume_refuses_a_mismatched_or_corrupt_checkpoint(tmp_path: Path) -> None:
+    train(tiny(episodes=2), tmp_path, env_factory=FACTORY)
+    ckpt = tmp_path / "checkpoints" / "checkpoint.pt"
+    with pytest.raises(CheckpointError, match=r"hidden_sizes.*") as err:
+        train(tiny(episodes=4, hidden_sizes=[8]), tmp_path, env_factory=FACTORY, resume=True)
+    assert str(ckpt) in str(err.value)
+    ckpt.write_bytes(b"not a checkpoint")
+    with pytest.raises(CheckpointError, match="corrupt") as err:
+        train(tiny(episodes=4), tmp_path, env_factory=FACTORY, resume=True)
+    assert str(ckpt) in str(err.value)
+    with pytest.raises(CheckpointError, match="not found"):
+        train(tiny(episodes=4), tmp_path / "empty", env_factory=FACTORY, resume=True)
+
+
+def test_subprocess_envs_collect_in_parallel(tmp_path: Path) -> None:
+    result = train(
+        tiny(episodes=4, num_envs=2, checkpoint_every_episodes=2),
+        tmp_path, env_factory=FACTORY, subprocess_envs=True,
+    )  # fmt: skip
+    # both envs play 20-step episodes in lockstep: 4 episodes = 80 transitions
+    assert (result.episodes, result.env_steps) == (4, 80)
+    assert sorted(int(r["episode"]) for r in rows(tmp_path)) == [0, 1, 2, 3]
+    assert {int(r["env"]) for r in rows(tmp_path)} == {0, 1}
+
+
+SCRIPT = """
+import functools, sys
+sys.path.insert(0, {root!r})
+from explaindrive.agent.config import TrainConfig
+from explaindrive.agent.trainer import train
+from tests.agent.fake_drive_env import FakeDriveEnv
+config = TrainConfig.from_dict({config!r})
+train(config, {out!r}, env_factory=functools.partial(FakeDriveEnv, max_steps=20,
+                                                     step_delay_s=0.002))
+"""
+
+
+@pytest.mark.slow
+def test_killed_run_resumes_from_its_last_checkpoint(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    config = tiny(episodes=100_000)
+    root = str(Path(__file__).resolve().parents[2])
+    code = textwrap.dedent(SCRIPT).format(root=root, config=config.to_dict(), out=str(out))
+    proc = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE)
+    ckpt = out / "checkpoints" / "checkpoint.pt"
+    deadline = time.monotonic() + 120
+    while not ckpt.exists():
+        assert proc.poll() is None, proc.stderr.read().decode() if proc.stderr else ""
+        assert time.monotonic() < deadline, "no checkpoint within 120 s"
+        time.sleep(0.05)
+    time.sleep(0.3)  # let it run past the checkpoint, so some transitions are lost
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+
+    saved = load_checkpoint(out / "checkpoints", config).trainer
+    done = saved["episodes_done"]
+    assert done % 4 == 0 and done >= 4
+    assert len(rows(out)) >= done  # rows written after the checkpoint are dropped on resume
+    result = train(config.replace(episodes=done + 3), out, env_factory=FACTORY, resume=True)
+    assert result.episodes == done + 3
+    assert result.env_steps == (done + 3) * EPISODE_STEPS
+    assert [int(r["episode"]) for r in rows(out)] == list(range(done + 3))
+
+
+def test_moving_average_by_hand() -> None:
+    assert moving_average([1, 2, 3, 4, 5], 2).tolist() == [1.0, 1.5, 2.5, 3.5, 4.5]
+    assert moving_average([1, 2, 3, 4, 5], 3).tolist() == [1.0, 1.5, 2.0, 3.0, 4.0]
