@@ -11,6 +11,7 @@ from typing import Any
 from explaindrive.sim.scenario.layout import validate_traffic_level
 
 TRAFFIC_LEVELS: tuple[float, ...] = (0.5, 0.75, 1.0, 1.25, 1.5)
+EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,6 +26,10 @@ class EnvConfig:
         net_file: a SUMO network to use instead of the shipped scenario.
         cache_dir: where generated demand files and warm-up states are kept.
         insert_timeout_s: how long the ego may wait for space to enter [s].
+        ego_model: ``"agent"`` (the action sets the speed, SUMO's checks off) or a SUMO
+            baseline that drives the ego itself with its safety checks on: ``"krauss"``
+            or ``"idm"``. Baselines ignore the action; a STOP command makes SUMO brake to
+            a standstill (at most 3 m/s^2) and hold it.
     """
 
     traffic_level: float = 1.0
@@ -34,6 +39,7 @@ class EnvConfig:
     net_file: Path | None = None
     cache_dir: Path | None = None
     insert_timeout_s: int = 60
+    ego_model: str = "agent"
 
     def __post_init__(self) -> None:
         validate_traffic_level(self.traffic_level)
@@ -43,6 +49,8 @@ class EnvConfig:
                 raise ValueError(f"{name} must be a positive integer, got {value!r}")
         if isinstance(self.warmup_s, bool) or not isinstance(self.warmup_s, int) or self.warmup_s < 0:
             raise ValueError(f"warmup_s must be an integer >= 0, got {self.warmup_s!r}")
+        if self.ego_model not in EGO_MODELS:
+            raise ValueError(f"ego_model must be one of {EGO_MODELS}, got {self.ego_model!r}")
         for name in ("net_file", "cache_dir"):
             value = getattr(self, name)
             if value is not None and not isinstance(value, Path):

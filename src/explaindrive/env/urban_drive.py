@@ -37,6 +37,7 @@ from explaindrive.sim.connection import SumoConnection
 from explaindrive.sim.pedestrians import PedestrianSource
 from explaindrive.sim.route import RouteGeometry, load_route_geometry
 from explaindrive.sim.scenario.files import (
+    BASELINE_EGO_TYPES,
     EGO_ID,
     EGO_ROUTE_ID,
     EGO_TYPE_ID,
@@ -207,9 +208,14 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         cmd = ep.command
         prev_obs = self._last_obs
         prev_pos = ep.pos_m
+        baseline = self.config.ego_model != "agent"
         v_new = max(0.0, ep.speed_mps + change)
         try:
-            api.vehicle.setSpeed(EGO_ID, v_new)
+            if baseline:
+                # SUMO drives; STOP asks it to brake to a standstill within its decel limit.
+                api.vehicle.setSpeed(EGO_ID, 0.0 if cmd is Command.STOP else -1.0)
+            else:
+                api.vehicle.setSpeed(EGO_ID, v_new)
             if ep.pedestrians is not None:
                 ep.pedestrians.step(api, ep.steps * STEP_LENGTH_S)
             api.simulationStep()
@@ -221,14 +227,16 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         collided = bool(sim.get(tc.VAR_COLLIDING_VEHICLES_IDS)) and self._ego_collided()
         arrived = EGO_ID in sim.get(tc.VAR_ARRIVED_VEHICLES_IDS, ())
         present = not collided and not arrived
-        accel = v_new - ep.speed_mps
-        jerk = accel - ep.accel_mps2
         if present:
             ego = api.vehicle.getSubscriptionResults(EGO_ID)
             v_new = float(ego[tc.VAR_SPEED])
             ep.pos_m = ep.start_pos_m + float(ego[tc.VAR_DISTANCE])
         else:
             ep.pos_m = prev_pos + v_new * STEP_LENGTH_S
+        if baseline:
+            change = int(round(v_new - ep.speed_mps))
+        accel = v_new - ep.speed_mps
+        jerk = accel - ep.accel_mps2
         red_run = self._ran_red_light(prev_pos, ep.pos_m)
         ped_violation = self._violated_crossing(prev_pos, ep.pos_m)
         legal_limit = self.geometry.limit_at(ep.pos_m)
@@ -319,7 +327,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ]
 
     def _state_file(self, level: float, seed: int) -> Path:
-        return self.scenario.state_dir() / f"level{level:g}_seed{seed}_w{self.config.warmup_s}.xml"
+        demand = self.scenario.routes_file(level).name.split(".")[0]  # carries the demand hash
+        return self.scenario.state_dir() / f"{demand}_seed{seed}_w{self.config.warmup_s}.xml"
 
     def _restore_warm_state(self, level: float, seed: int) -> None:
         """Continue from the cached warm-up state of (level, seed), creating it if needed."""
@@ -339,8 +348,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def _insert_ego(self) -> float:
         api = self._conn.api
+        model = self.config.ego_model
+        type_id = EGO_TYPE_ID if model == "agent" else BASELINE_EGO_TYPES[model]
         api.vehicle.add(
-            EGO_ID, EGO_ROUTE_ID, typeID=EGO_TYPE_ID, depart="now",
+            EGO_ID, EGO_ROUTE_ID, typeID=type_id, depart="now",
             departLane="best", departPos="base", departSpeed="0",
         )
         for _ in range(self.config.insert_timeout_s):
@@ -352,9 +363,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
                 f"the ego could not enter within {self.config.insert_timeout_s} s "
                 "(the first road stays blocked); lower the traffic level"
             )
-        api.vehicle.setSpeedMode(EGO_ID, 0)  # no car-following, light or right-of-way checks
         api.vehicle.setLaneChangeMode(EGO_ID, 0)
-        api.vehicle.setSpeed(EGO_ID, 0.0)
+        if model == "agent":
+            api.vehicle.setSpeedMode(EGO_ID, 0)  # no car-following, light or right-of-way checks
+            api.vehicle.setSpeed(EGO_ID, 0.0)
         api.vehicle.subscribe(EGO_ID, _EGO_VARS, parameters={tc.VAR_LEADER: S.SENSOR_RANGE_M})
         if not self._tls_link:
             self._tls_link = {t[0]: int(t[1]) for t in api.vehicle.getNextTLS(EGO_ID)}

@@ -15,6 +15,8 @@ from explaindrive.sim.scenario import layout
 EGO_ROUTE_ID = "ego_route"
 EGO_TYPE_ID = "ego_type"
 EGO_ID = "ego"
+# vTypes of the ego when SUMO drives it (baselines): same size and limits as the agent's ego.
+BASELINE_EGO_TYPES: dict[str, str] = {"krauss": "ego_krauss", "idm": "ego_idm"}
 FLOW_END_S = 4_000  # [s] flows outlast warm-up plus the longest episode
 
 
@@ -46,6 +48,12 @@ def routes_xml(traffic_level: float) -> str:
         f'    <vType id="{EGO_TYPE_ID}" length="5" minGap="2.5" maxSpeed="20" accel="3" '
         'decel="3" emergencyDecel="9" color="1,0,0" guiShape="passenger"/>'
     )
+    for model, type_id in BASELINE_EGO_TYPES.items():
+        cf = "Krauss" if model == "krauss" else "IDM"
+        lines.append(
+            f'    <vType id="{type_id}" length="5" minGap="2.5" maxSpeed="20" accel="3" '
+            f'decel="3" emergencyDecel="9" carFollowModel="{cf}" color="0,0,1"/>'
+        )
     lines.append(
         '    <vType id="background" length="5" minGap="2.5" maxSpeed="20" accel="2.6" '
         'decel="4.5" sigma="0.5" carFollowModel="Krauss" color="0.8,0.8,0.2"/>'
