@@ -52,6 +52,8 @@ log = logging.getLogger(__name__)
 _EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER)
 _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
+ENTRY_CLEAR_AFTER_S = 10  # [s] waiting for a gap before the entry stretch is cleared
+ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
 
 
 @dataclass(slots=True)
@@ -354,10 +356,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             EGO_ID, EGO_ROUTE_ID, typeID=type_id, depart="now",
             departLane="best", departPos="base", departSpeed="0",
         )
-        for _ in range(self.config.insert_timeout_s):
+        for waited in range(self.config.insert_timeout_s):
             api.simulationStep()
             if EGO_ID in api.simulation.getDepartedIDList():
                 break
+            if waited == ENTRY_CLEAR_AFTER_S:
+                self._clear_entry()
         else:
             raise RuntimeError(
                 f"the ego could not enter within {self.config.insert_timeout_s} s "
@@ -377,6 +381,15 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             for edge in (crossing.crossing_edge, *crossing.walkingareas):
                 api.edge.subscribe(edge, (tc.LAST_STEP_PERSON_ID_LIST,))
         return float(api.vehicle.getLanePosition(EGO_ID))
+
+    def _clear_entry(self) -> None:
+        """Remove background vehicles from the ego's entry stretch (oversaturated demand)."""
+        api = self._conn.api
+        lane = f"{EGO_ROUTE_EDGES[0]}_1"
+        for vid in api.lane.getLastStepVehicleIDs(lane):
+            if vid != EGO_ID and api.vehicle.getLanePosition(vid) < ENTRY_CLEAR_M:
+                api.vehicle.remove(vid)
+        log.debug("cleared the ego's entry stretch after %d s of waiting", ENTRY_CLEAR_AFTER_S)
 
     def _apply_schedule(self, now_s: float) -> None:
         ep = self._episode()

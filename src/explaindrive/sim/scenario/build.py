@@ -120,7 +120,29 @@ def build_network(out_dir: Path) -> Path:
     if proc.returncode != 0:
         raise RuntimeError(f"netconvert failed ({proc.returncode}):\n{proc.stderr}")
     _apply_offset(net_file, "J2", layout.TLS_OFFSET_J2_S)
+    for tls_id, durations in layout.TLS_PHASE_DURATIONS_S.items():
+        _apply_durations(net_file, tls_id, durations)
     return net_file
+
+
+def _apply_durations(net_file: Path, tls_id: str, durations: tuple[int, ...]) -> None:
+    """Set the phase durations of one static program in the generated network."""
+    import re
+
+    text = net_file.read_text()
+    block = re.search(rf'<tlLogic id="{tls_id}".*?</tlLogic>', text, flags=re.S)
+    if block is None:
+        raise RuntimeError(f"traffic light {tls_id!r} not found in {net_file}")
+    phases = re.findall(r'<phase duration="\d+"\s*', block.group(0))
+    if len(phases) != len(durations):
+        raise RuntimeError(
+            f"traffic light {tls_id!r} has {len(phases)} phases, layout gives {len(durations)}"
+        )
+    it = iter(durations)
+    new_block = re.sub(
+        r'<phase duration="\d+"\s*', lambda _m: f'<phase duration="{next(it)}" ', block.group(0)
+    )
+    net_file.write_text(text.replace(block.group(0), new_block))
 
 
 def _apply_offset(net_file: Path, tls_id: str, offset_s: int) -> None:

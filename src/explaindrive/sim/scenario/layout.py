@@ -149,10 +149,16 @@ PEDESTRIAN_FLOWS: tuple[PedestrianFlow, ...] = (
     PedestrianFlow("j2_southbound", "J2_Z2", "Z2_J2", 120.0, 150.0, 50.0),
 )
 
-# Signal timing passed to netconvert (static programs, seconds).
+# Signal timing (static programs, seconds). netconvert builds the phases; their
+# durations are then set here: the main road gets most of the 60 s cycle so that
+# it carries its demand up to about traffic level 1.5.
 TLS_CYCLE_S = 60
 TLS_YELLOW_S = 3
 TLS_OFFSET_J2_S = 25  # [s] offset of J2 against J1 (a partial green wave)
+TLS_PHASE_DURATIONS_S: dict[str, tuple[int, ...]] = {
+    "J1": (39, 3, 15, 3),  # main green, yellow, side green, yellow
+    "J2": (36, 3, 15, 3, 3),  # main green, yellow, side + pedestrians, side only, yellow
+}
 
 
 def traffic_level_demand(level: float) -> float:
