@@ -24,13 +24,18 @@ class FakeDriveEnv(gym.Env[np.ndarray, int]):
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
 
     def __init__(
-        self, max_steps: int = 20, route_m: float | None = None, step_delay_s: float = 0.0
+        self,
+        max_steps: int = 20,
+        route_m: float | None = None,
+        step_delay_s: float = 0.0,
+        fail_seeds: tuple[int, ...] = (),
     ):
         self.observation_space = gym.spaces.Box(STATE_LOW, STATE_HIGH, (STATE_DIM,), np.float32)
         self.action_space = gym.spaces.Discrete(N_ACTIONS)
         self.max_steps = max_steps
         self.route_m = route_m
         self.step_delay_s = step_delay_s
+        self.fail_seeds = fail_seeds
         self.command = Command.FAST
         self.schedule: list[tuple[float, Command]] = []
         self.v = self.x = 0.0
@@ -47,6 +52,8 @@ class FakeDriveEnv(gym.Env[np.ndarray, int]):
         )  # fmt: skip
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        if seed in self.fail_seeds:
+            raise RuntimeError(f"the ego could not enter (seed {seed})")
         super().reset(seed=seed)
         options = options or {}
         self.command = Command.parse(options.get("command", "fast"))

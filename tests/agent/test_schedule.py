@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from explaindrive.agent.config import PAPER
+from explaindrive.agent.config import PAPER, SEED_POOL_BASE
 from explaindrive.agent.schedule import plan_episode, stop_schedule
 from explaindrive.commands import Command
 
@@ -35,3 +35,9 @@ def test_stop_schedule_gaps_and_durations() -> None:
     sched = stop_schedule(np.random.default_rng(0), Command.FAST, (10, 10), (4, 4), 40.0)
     assert sched == ((10.0, "stop"), (14.0, "fast"), (24.0, "stop"), (28.0, "fast"),
                      (38.0, "stop"), (42.0, "fast"))  # fmt: skip
+
+
+def test_seed_pool_bounds_the_episode_seeds() -> None:
+    cfg = PAPER.replace(seed_pool=3)
+    seeds = {plan_episode(cfg, i).seed for i in range(60)}
+    assert seeds == {SEED_POOL_BASE, SEED_POOL_BASE + 1, SEED_POOL_BASE + 2}

@@ -16,8 +16,9 @@ from pathlib import Path
 import pytest
 
 from explaindrive.agent.checkpoint import CheckpointError, load_checkpoint
-from explaindrive.agent.config import TrainConfig, preset
+from explaindrive.agent.config import SEED_POOL_BASE, TrainConfig, preset
 from explaindrive.agent.controller import QPolicy
+from explaindrive.agent.schedule import plan_episode
 from explaindrive.agent.trainer import moving_average, train
 from tests.agent.fake_drive_env import FakeDriveEnv
 
@@ -57,7 +58,10 @@ def test_tiny_run_writes_every_output(tmp_path: Path) -> None:
     ckpt = load_checkpoint(tmp_path / "checkpoints")
     assert ckpt.trainer["episodes_done"] == 10 and ckpt.replay is not None
     assert ckpt.replay["obs"].shape == (200, 8)
-    assert json.loads((tmp_path / "checkpoints" / "config.json").read_text())["config"]["mode"] == "fast"
+    assert (
+        json.loads((tmp_path / "checkpoints" / "config.json").read_text())["config"]["mode"]
+        == "fast"
+    )
 
     from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
 
@@ -101,6 +105,19 @@ def test_subprocess_envs_collect_in_parallel(tmp_path: Path) -> None:
     assert (result.episodes, result.env_steps) == (4, 80)
     assert sorted(int(r["episode"]) for r in rows(tmp_path)) == [0, 1, 2, 3]
     assert {int(r["env"]) for r in rows(tmp_path)} == {0, 1}
+
+
+def test_episodes_that_cannot_start_get_a_new_seed(tmp_path: Path) -> None:
+    config = tiny(episodes=8, seed_pool=2)
+    bad = SEED_POOL_BASE
+    n_bad = sum(plan_episode(config, i).seed == bad for i in range(8))
+    assert 0 < n_bad < 8
+    factory = functools.partial(FakeDriveEnv, max_steps=EPISODE_STEPS, fail_seeds=(bad,))
+    result = train(config, tmp_path, env_factory=factory)
+    assert (result.episodes, result.env_steps) == (8, 160)
+    card = QPolicy.load(result.policy_path).card
+    assert card["reset_failures"] == n_bad
+    assert bad not in {int(r["seed"]) for r in rows(tmp_path)}
 
 
 SCRIPT = """

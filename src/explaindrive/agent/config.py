@@ -28,6 +28,7 @@ _NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
 TRAIN_MODES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
 LOSSES: tuple[str, ...] = ("mse", "huber")
+SEED_POOL_BASE = 100_000  # training seeds from a pool start here, clear of evaluation seeds
 
 
 class ConfigError(ValueError):
@@ -94,6 +95,9 @@ class TrainConfig:
     """Range [s] of the random duration of each injected stop command."""
     schedule_horizon_s: float = 900.0
     """Stop commands are scheduled up to this simulated time [s]."""
+    seed_pool: int | None = None
+    """If set, episode seeds are drawn from this many values (``SEED_POOL_BASE`` onwards), so
+    the env's cached warm-up states are reused; ``None`` gives every episode a fresh seed."""
     max_episode_steps: int | None = None
     """Env step limit per episode; ``None`` keeps the env's default."""
 
@@ -174,7 +178,7 @@ def _problems(c: TrainConfig) -> typing.Iterator[str]:
     for name in positive:
         if getattr(c, name) <= 0:
             yield f"{name} must be > 0, got {getattr(c, name)}"
-    for name in ("num_envs", "max_episode_steps"):
+    for name in ("num_envs", "max_episode_steps", "seed_pool"):
         value = getattr(c, name)
         if value is not None and value <= 0:
             yield f"{name} must be > 0 or null, got {value}"
@@ -272,6 +276,7 @@ FAST = TrainConfig(
     eps_end=0.02,
     eps_decay_steps=100_000,
     checkpoint_every_episodes=25,
+    seed_pool=250,
 )
 """Tuned for wall time on 2 CPU cores: short linear exploration, lr decay, one update per
 two transitions, Polyak-averaged target, Huber loss with gradient clipping."""

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from explaindrive.agent.config import TrainConfig
+from explaindrive.agent.config import SEED_POOL_BASE, TrainConfig
 from explaindrive.commands import Command
 
 
@@ -70,7 +70,10 @@ def plan_episode(config: TrainConfig, index: int) -> EpisodePlan:
     if index < 0:
         raise ValueError(f"episode index must be >= 0, got {index}")
     rng = np.random.default_rng([config.seed, index])
-    seed = int(rng.integers(0, 2**31 - 1))
+    if config.seed_pool is None:
+        seed = int(rng.integers(0, 2**31 - 1))
+    else:
+        seed = SEED_POOL_BASE + int(rng.integers(config.seed_pool))
     level = float(config.traffic_levels[int(rng.integers(len(config.traffic_levels)))])
     primary = config.command
     schedule: tuple[tuple[float, str], ...] = ()

@@ -23,7 +23,7 @@ import logging
 import subprocess
 import time
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -44,7 +44,7 @@ from explaindrive.agent.checkpoint import (
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.schedule import EpisodePlan, plan_episode
-from explaindrive.agent.vec_env import EnvFactory, VecEnv, make_vec_env
+from explaindrive.agent.vec_env import RESET_FAILED, EnvFactory, VecEnv, make_vec_env
 
 log = logging.getLogger(__name__)
 
@@ -54,6 +54,12 @@ CSV_FIELDS: tuple[str, ...] = (
     "mean_speed_mps", "distance_m", "terminated", "truncated", "wall_time_s",
 )  # fmt: skip
 SAFETY_FLAGS: tuple[str, ...] = ("collision", "red_light_run", "ped_violation")
+MAX_RESET_ATTEMPTS = 5
+
+
+def reseed(seed: int, attempt: int) -> int:
+    """Replacement seed for an episode whose env could not start with ``seed``."""
+    return int(np.random.default_rng([seed, attempt, 7]).integers(0, 2**31 - 1))
 
 
 def make_urban_drive_env(max_steps: int | None = None) -> gym.Env:
@@ -245,6 +251,7 @@ class Trainer:
         self.pending: deque[int] = deque()
         self.update_debt = 0.0
         self.wall_time_s = 0.0
+        self.reset_failures = 0
         self.recent_returns: deque[float] = deque(maxlen=config.moving_average_window)
 
         if resume:
@@ -264,6 +271,7 @@ class Trainer:
             "pending": [*running, *self.pending],
             "update_debt": self.update_debt,
             "wall_time_s": self.wall_time_s,
+            "reset_failures": self.reset_failures,
             "recent_returns": list(self.recent_returns),
             "rng": self.rng.bit_generator.state,
             "torch_rng": torch.get_rng_state(),
@@ -284,6 +292,7 @@ class Trainer:
         self.pending = deque(int(i) for i in t["pending"])
         self.update_debt = float(t["update_debt"])
         self.wall_time_s = float(t["wall_time_s"])
+        self.reset_failures = int(t.get("reset_failures", 0))
         self.recent_returns.extend(float(r) for r in t["recent_returns"])
         self.rng.bit_generator.state = t["rng"]
         torch.set_rng_state(t["torch_rng"])
@@ -397,12 +406,28 @@ class Trainer:
             starts.append((i, plan))
         if not starts:
             return
-        env_ids = [i for i, _ in starts]
-        plans = [p for _, p in starts]
-        first, _ = vec.reset(env_ids, [p.seed for p in plans], [p.reset_options() for p in plans])
-        obs[env_ids] = first
-        for i, plan in starts:
-            episodes[i] = _Episode(plan)
+        for attempt in range(MAX_RESET_ATTEMPTS):
+            env_ids = [i for i, _ in starts]
+            plans = [p for _, p in starts]
+            first, infos = vec.reset(
+                env_ids, [p.seed for p in plans], [p.reset_options() for p in plans]
+            )
+            retry = []
+            for k, (i, plan) in enumerate(starts):
+                if RESET_FAILED in infos[k]:
+                    self.reset_failures += 1
+                    log.warning("episode %d (seed %d) could not start: %s; new seed",
+                                plan.index, plan.seed, infos[k][RESET_FAILED])  # fmt: skip
+                    retry.append((i, replace(plan, seed=reseed(plan.seed, attempt))))
+                else:
+                    obs[i] = first[k]
+                    episodes[i] = _Episode(plan)
+            if not retry:
+                return
+            starts = retry
+        raise RuntimeError(
+            f"envs {[i for i, _ in starts]} failed to start an episode {MAX_RESET_ATTEMPTS} times"
+        )
 
     def _train(self, tb: Any, new_transitions: int) -> None:
         """Run the gradient updates owed for ``new_transitions`` (one per ``train_frequency``)."""
@@ -460,6 +485,7 @@ class Trainer:
             "wall_time_s": round(self.wall_time_s, 1),
             "steps_per_s": round(steps_per_s, 1),
             "num_envs": c.envs,
+            "reset_failures": self.reset_failures,
             "final_mean_return": (
                 float(np.mean(self.recent_returns)) if self.recent_returns else None
             ),

@@ -61,7 +61,7 @@ class SyncVecEnv:
     ) -> tuple[np.ndarray, list[dict[str, Any]]]:
         """See :meth:`VecEnv.reset`."""
         results = [
-            self.envs[i].reset(seed=int(s), options=o)
+            _safe_reset(self.envs[i], int(s), o)
             for i, s, o in zip(indices, seeds, options, strict=True)
         ]
         return np.stack([r[0] for r in results]).astype(np.float32), [r[1] for r in results]
@@ -88,6 +88,21 @@ def _stack(results: Sequence[tuple[Any, ...]]) -> StepResult:
     )
 
 
+RESET_FAILED = "reset_failed"
+"""Info key set (with the error message) when an env could not start an episode; the
+observation is then NaN and the caller should retry with another seed."""
+
+
+def _safe_reset(env: gym.Env, seed: int, options: dict[str, Any]) -> tuple[Any, dict[str, Any]]:
+    """``env.reset``, turning a failure to start this episode into a ``RESET_FAILED`` info."""
+    try:
+        return env.reset(seed=seed, options=options)
+    except (RuntimeError, OSError) as exc:  # e.g. the ego cannot enter a blocked road
+        log.warning("reset with seed %s failed: %s", seed, exc)
+        shape = env.observation_space.shape or (1,)
+        return np.full(shape, np.nan, dtype=np.float32), {RESET_FAILED: str(exc)}
+
+
 def _worker(conn: Connection, factory: EnvFactory) -> None:
     """Worker loop: build the env, then serve ``reset``/``step``/``close`` requests."""
     os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -103,7 +118,7 @@ def _worker(conn: Connection, factory: EnvFactory) -> None:
                 conn.send(("ok", env.step(int(data))))
             elif cmd == "reset":
                 seed, options = data
-                conn.send(("ok", env.reset(seed=seed, options=options)))
+                conn.send(("ok", _safe_reset(env, seed, options)))
             elif cmd == "close":
                 break
             else:

@@ -1,0 +1,92 @@
+"""Policy files and the merged controller."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from explaindrive.agent.checkpoint import CheckpointError, load_policy, save_policy
+from explaindrive.agent.controller import MergedController, QPolicy, shipped_policy_path
+from explaindrive.agent.network import DuelingQNetwork
+from explaindrive.commands import Command
+
+OBS = np.array([0, 5.0, 13.9, 200.0, 0.0, 200.0, 0, 200.0], dtype=np.float32)
+
+
+def constant_policy(tmp_path: Path, name: str, action: int) -> Path:
+    """A network whose Q-values ignore the input and peak at ``action``."""
+    net = DuelingQNetwork((4,))
+    with torch.no_grad():
+        for p in net.parameters():
+            p.zero_()
+        net.advantage.bias[action] = 1.0
+    path, _ = save_policy(tmp_path / f"{name}.pt", net, {"name": name})
+    return path
+
+
+def test_policy_round_trip_and_raw_observations(tmp_path: Path) -> None:
+    torch.manual_seed(0)
+    net = DuelingQNetwork((8, 8))
+    path, card_path = save_policy(tmp_path / "p", net, {"name": "p", "episodes": 3})
+    loaded, card = load_policy(path)
+    assert card == {"name": "p", "episodes": 3} and card_path.name == "p.json"
+    x = torch.from_numpy(OBS[None])
+    assert torch.equal(loaded(x), net(x))
+    policy = QPolicy(loaded, card)
+    assert policy.act(OBS) == int(net(x).argmax())
+
+
+def test_bad_policy_files_name_the_file(tmp_path: Path) -> None:
+    path = constant_policy(tmp_path, "fast", 6)
+    path.with_suffix(".json").unlink()
+    with pytest.raises(CheckpointError, match="policy card not found") as err:
+        load_policy(path)
+    assert str(path.with_suffix(".json")) in str(err.value)
+    path.write_bytes(b"\x00garbage")
+    with pytest.raises(CheckpointError, match="corrupt") as err:
+        load_policy(path)
+    assert str(path) in str(err.value)
+    with pytest.raises(CheckpointError, match="not found"):
+        load_policy(tmp_path / "missing.pt")
+
+
+def test_merged_controller_routes_commands(tmp_path: Path) -> None:
+    ctrl = MergedController.from_files(
+        constant_policy(tmp_path, "fast", 6), constant_policy(tmp_path, "comfort", 1)
+    )
+    assert ctrl.act(OBS) == 6
+    ctrl.set_command("stop")  # stop keeps the fast agent, fed cmd = 2
+    assert ctrl.active_agent is Command.FAST and ctrl.observation(OBS)[0] == 2.0
+    assert ctrl.act(OBS) == 6
+    ctrl.set_command(Command.COMFORT)
+    assert ctrl.act(OBS) == 1 and ctrl.observation(OBS)[0] == 1.0
+    ctrl.set_command(2)
+    assert (ctrl.active_agent, ctrl.command, ctrl.act(OBS)) == (Command.COMFORT, Command.STOP, 1)
+    with pytest.raises(ValueError, match="unknown command"):
+        ctrl.set_command("turbo")
+
+
+def test_stop_reaches_the_agent_as_cmd_2(tmp_path: Path) -> None:
+    """A network that brakes hard only when cmd = 2 (first input) shows the stop routing."""
+    net = DuelingQNetwork((1,))
+    with torch.no_grad():
+        for p in net.parameters():
+            p.zero_()
+        net.trunk[0].weight[0, 0] = 1.0  # feature = cmd / 2
+        net.advantage.weight[0, 0] = 1.0  # action 0 (-3 m/s) grows with cmd
+        net.advantage.bias[3] = 0.75  # idle wins for cmd 0 and 1 (0, 0.5), loses for 2 (1.0)
+    fast, _ = save_policy(tmp_path / "fast.pt", net, {})
+    ctrl = MergedController.from_files(fast, constant_policy(tmp_path, "comfort", 3))
+    assert ctrl.act(OBS) == 3
+    ctrl.set_command("stop")
+    assert ctrl.act(OBS) == 0
+
+
+def test_shipped_policy_paths() -> None:
+    assert shipped_policy_path("fast").name == "fast.pt"
+    assert shipped_policy_path("comfort").parent.name == "policies"
+    with pytest.raises(ValueError, match="no shipped policy"):
+        shipped_policy_path("stop")
