@@ -7,12 +7,34 @@ import pytest
 from explaindrive.env.metrics import EpisodeMetrics, stop_latency_bound
 
 
-def info(speed, command="fast", *, headway=math.inf, ttc=math.inf, jerk=0.0, dist=0.0, t=0.0,
-         collision=False, red=False, ped=False, speeding=False, arrived=False):
+def info(
+    speed,
+    command="fast",
+    *,
+    headway=math.inf,
+    ttc=math.inf,
+    jerk=0.0,
+    dist=0.0,
+    t=0.0,
+    collision=False,
+    red=False,
+    ped=False,
+    speeding=False,
+    arrived=False,
+):
     return {
-        "speed_mps": speed, "command": command, "real_headway_s": headway, "real_ttc_s": ttc,
-        "jerk_mps3": jerk, "distance_m": dist, "time_s": t, "collision": collision,
-        "red_light_run": red, "ped_violation": ped, "speeding": speeding, "arrived": arrived,
+        "speed_mps": speed,
+        "command": command,
+        "real_headway_s": headway,
+        "real_ttc_s": ttc,
+        "jerk_mps3": jerk,
+        "distance_m": dist,
+        "time_s": t,
+        "collision": collision,
+        "red_light_run": red,
+        "ped_violation": ped,
+        "speeding": speeding,
+        "arrived": arrived,
     }
 
 
@@ -36,8 +58,16 @@ def test_episode_figures():
 
 def test_stop_latency_counts_steps_to_standstill():
     m = EpisodeMetrics()
-    for speed, cmd in [(9, "fast"), (6, "stop"), (3, "stop"), (0, "stop"), (0, "stop"),
-                       (2, "fast"), (1, "stop"), (1, "comfort")]:
+    for speed, cmd in [
+        (9, "fast"),
+        (6, "stop"),
+        (3, "stop"),
+        (0, "stop"),
+        (0, "stop"),
+        (2, "fast"),
+        (1, "stop"),
+        (1, "comfort"),
+    ]:
         m.update(info(float(speed), cmd))
     r = m.result()
     assert r.stop_latencies == (3,)

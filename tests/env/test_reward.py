@@ -74,8 +74,15 @@ def test_stop_reward():
 
 def _features(**kw):
     base = dict(
-        speed_mps=10.0, speed_change_mps=1, limit_mps=13.89, ttc_s=1.0, headway_s=1.0,
-        jerk_mps3=2.0, violation=False, stop_reason=None, collided=False,
+        speed_mps=10.0,
+        speed_change_mps=1,
+        limit_mps=13.89,
+        ttc_s=1.0,
+        headway_s=1.0,
+        jerk_mps3=2.0,
+        violation=False,
+        stop_reason=None,
+        collided=False,
     )
     base.update(kw)
     return R.StepFeatures(**base)
@@ -104,6 +111,12 @@ def test_comfort_reward_terms():
 def test_stop_reward_terms_only_hold_the_stop_term():
     t = R.reward_terms(Command.STOP, _features(speed_change_mps=1))
     assert t.as_dict() == {
-        "ttc": 0.0, "headway": 0.0, "jerk": 0.0, "traffic": 0.0, "speed": 0.0,
-        "collision": 0.0, "stop": -50.0, "total": -50.0,
+        "ttc": 0.0,
+        "headway": 0.0,
+        "jerk": 0.0,
+        "traffic": 0.0,
+        "speed": 0.0,
+        "collision": 0.0,
+        "stop": -50.0,
+        "total": -50.0,
     }

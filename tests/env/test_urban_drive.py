@@ -124,7 +124,7 @@ def test_command_schedule_and_set_command(make_env):
     obs, _ = env.reset(seed=4, options={"command_schedule": [(3, "stop"), (5, "comfort")]})
     cmds = [obs[S.CMD]]
     for _ in range(6):
-        obs, reward, *_ , info = env.step(action_index(1))
+        obs, reward, *_, info = env.step(action_index(1))
         cmds.append(obs[S.CMD])
     assert cmds == [0, 0, 0, 2, 2, 1, 1]
     env.unwrapped.set_command("stop")
@@ -145,7 +145,16 @@ def test_info_carries_the_reward_terms(make_env):
     env.reset(seed=5)
     _, reward, _, _, info = env.step(action_index(2))
     terms = info["reward_terms"]
-    assert set(terms) == {"ttc", "headway", "jerk", "traffic", "speed", "collision", "stop", "total"}
+    assert set(terms) == {
+        "ttc",
+        "headway",
+        "jerk",
+        "traffic",
+        "speed",
+        "collision",
+        "stop",
+        "total",
+    }
     assert terms["total"] == pytest.approx(reward)
     assert terms["speed"] == pytest.approx(3 * 2 / (50 / 3.6), abs=1e-3)
 

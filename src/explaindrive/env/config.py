@@ -47,7 +47,11 @@ class EnvConfig:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
                 raise ValueError(f"{name} must be a positive integer, got {value!r}")
-        if isinstance(self.warmup_s, bool) or not isinstance(self.warmup_s, int) or self.warmup_s < 0:
+        if (
+            isinstance(self.warmup_s, bool)
+            or not isinstance(self.warmup_s, int)
+            or self.warmup_s < 0
+        ):
             raise ValueError(f"warmup_s must be an integer >= 0, got {self.warmup_s!r}")
         if self.ego_model not in EGO_MODELS:
             raise ValueError(f"ego_model must be one of {EGO_MODELS}, got {self.ego_model!r}")
@@ -66,5 +70,7 @@ class EnvConfig:
         known = {f.name for f in dataclasses.fields(cls)}
         unknown = sorted(set(data) - known)
         if unknown:
-            raise ValueError(f"unknown env config key(s): {', '.join(unknown)}; known: {sorted(known)}")
+            raise ValueError(
+                f"unknown env config key(s): {', '.join(unknown)}; known: {sorted(known)}"
+            )
         return cls(**dict(data))

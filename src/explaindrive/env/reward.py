@@ -135,16 +135,26 @@ class RewardTerms:
     def total(self) -> float:
         """Sum of the terms."""
         return (
-            self.ttc + self.headway + self.jerk + self.traffic + self.speed + self.collision
+            self.ttc
+            + self.headway
+            + self.jerk
+            + self.traffic
+            + self.speed
+            + self.collision
             + self.stop
         )
 
     def as_dict(self) -> dict[str, float]:
         """Terms plus ``total`` as a plain dict (for ``info``)."""
         return {
-            "ttc": self.ttc, "headway": self.headway, "jerk": self.jerk,
-            "traffic": self.traffic, "speed": self.speed, "collision": self.collision,
-            "stop": self.stop, "total": self.total,
+            "ttc": self.ttc,
+            "headway": self.headway,
+            "jerk": self.jerk,
+            "traffic": self.traffic,
+            "speed": self.speed,
+            "collision": self.collision,
+            "stop": self.stop,
+            "total": self.total,
         }
 
 

@@ -25,7 +25,7 @@ class CautiousDriver:
     def __call__(self, obs: NDArray[np.floating]) -> int:
         """Action index for a raw observation."""
         v = float(obs[S.V_EGO])
-        if int(round(float(obs[S.CMD]))) == Command.STOP:
+        if round(float(obs[S.CMD])) == Command.STOP:
             return action_index(-min(3, math.ceil(v)))
         room = max(0.0, float(obs[S.D_LEAD]) - STANDSTILL_GAP_M)
         target = min(float(obs[S.V_LIM]), math.sqrt(2.0 * COMFORT_DECEL_MPS2 * room))

@@ -36,18 +36,32 @@ STATE_DIM = len(STATE_NAMES)
 
 CMD, V_EGO, V_LIM, D_LEAD, DV, D_TL, TLS, D_CROSS = range(STATE_DIM)
 
-STATE_LOW = np.array(
-    [0.0, 0.0, 0.0, 0.0, -MAX_SPEED_MPS, 0.0, 0.0, 0.0], dtype=np.float32
-)
+STATE_LOW = np.array([0.0, 0.0, 0.0, 0.0, -MAX_SPEED_MPS, 0.0, 0.0, 0.0], dtype=np.float32)
 STATE_HIGH = np.array(
-    [2.0, MAX_SPEED_MPS, MAX_SPEED_MPS, SENSOR_RANGE_M, MAX_SPEED_MPS, SENSOR_RANGE_M, 2.0,
-     SENSOR_RANGE_M],
+    [
+        2.0,
+        MAX_SPEED_MPS,
+        MAX_SPEED_MPS,
+        SENSOR_RANGE_M,
+        MAX_SPEED_MPS,
+        SENSOR_RANGE_M,
+        2.0,
+        SENSOR_RANGE_M,
+    ],
     dtype=np.float32,
 )
 # Scales used by the optional normalisation: each component divided by its scale lies in [-1, 1].
 STATE_SCALE = np.array(
-    [2.0, MAX_SPEED_MPS, MAX_SPEED_MPS, SENSOR_RANGE_M, MAX_SPEED_MPS, SENSOR_RANGE_M, 2.0,
-     SENSOR_RANGE_M],
+    [
+        2.0,
+        MAX_SPEED_MPS,
+        MAX_SPEED_MPS,
+        SENSOR_RANGE_M,
+        MAX_SPEED_MPS,
+        SENSOR_RANGE_M,
+        2.0,
+        SENSOR_RANGE_M,
+    ],
     dtype=np.float32,
 )
 
@@ -90,8 +104,16 @@ class DrivingState:
     def to_array(self) -> NDArray[np.float32]:
         """The observation vector in :data:`STATE_NAMES` order."""
         return np.array(
-            [self.cmd, self.v_ego, self.v_lim, self.d_lead, self.dv, self.d_tl, self.tls,
-             self.d_cross],
+            [
+                self.cmd,
+                self.v_ego,
+                self.v_lim,
+                self.d_lead,
+                self.dv,
+                self.d_tl,
+                self.tls,
+                self.d_cross,
+            ],
             dtype=np.float32,
         )
 
@@ -101,13 +123,13 @@ class DrivingState:
         if obs.shape != (STATE_DIM,):
             raise ValueError(f"expected a state of shape ({STATE_DIM},), got {obs.shape}")
         return cls(
-            cmd=int(round(float(obs[CMD]))),
+            cmd=round(float(obs[CMD])),
             v_ego=float(obs[V_EGO]),
             v_lim=float(obs[V_LIM]),
             d_lead=float(obs[D_LEAD]),
             dv=float(obs[DV]),
             d_tl=float(obs[D_TL]),
-            tls=int(round(float(obs[TLS]))),
+            tls=round(float(obs[TLS])),
             d_cross=float(obs[D_CROSS]),
         )
 

@@ -189,8 +189,13 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._ep.pos_m = start_pos
         obs, _leader, _ = self._observe()
         self._last_obs = obs
-        info = {"command": self._ep.command.label, "traffic_level": level, "seed": int(sumo_seed),
-                "time_s": 0.0, "distance_m": 0.0}
+        info = {
+            "command": self._ep.command.label,
+            "traffic_level": level,
+            "seed": int(sumo_seed),
+            "time_s": 0.0,
+            "distance_m": 0.0,
+        }
         return self._output(obs), info
 
     def step(
@@ -205,7 +210,11 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep = self._episode()
         if ep.done:
             raise RuntimeError("the episode is over; call reset() before step()")
-        change = speed_change(int(action)) if isinstance(action, int | np.integer) else speed_change(action)
+        change = (
+            speed_change(int(action))
+            if isinstance(action, int | np.integer)
+            else speed_change(action)
+        )
         api = self._conn.api
         cmd = ep.command
         prev_obs = self._last_obs
@@ -236,7 +245,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         else:
             ep.pos_m = prev_pos + v_new * STEP_LENGTH_S
         if baseline:
-            change = int(round(v_new - ep.speed_mps))
+            change = round(v_new - ep.speed_mps)
         accel = v_new - ep.speed_mps
         jerk = accel - ep.accel_mps2
         red_run = self._ran_red_light(prev_pos, ep.pos_m)
@@ -290,7 +299,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             "ttc_s": ttc,
             "headway_s": headway,
             "real_gap_m": real.gap_m if real else math.inf,
-            "real_ttc_s": time_to_collision(real.gap_m, v_new - real.speed_mps) if real else math.inf,
+            "real_ttc_s": time_to_collision(real.gap_m, v_new - real.speed_mps)
+            if real
+            else math.inf,
             "real_headway_s": time_headway(real.gap_m, real.length_m, v_new) if real else math.inf,
             "distance_m": ep.pos_m - ep.start_pos_m,
             "collision": collided,
@@ -315,17 +326,28 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def _sumo_args(self, level: float, seed: int) -> list[str]:
         return [
-            "-n", str(self.scenario.net_file),
-            "-r", str(self.scenario.routes_file(level)),
-            "--seed", str(seed),
-            "--step-length", str(STEP_LENGTH_S),
-            "--no-step-log", "true",
-            "--no-warnings", "true",
-            "--collision.action", "remove",
-            "--collision.check-junctions", "true",
-            "--collision.mingap-factor", "0",
-            "--save-state.rng", "true",
-            "--time-to-teleport", "300",
+            "-n",
+            str(self.scenario.net_file),
+            "-r",
+            str(self.scenario.routes_file(level)),
+            "--seed",
+            str(seed),
+            "--step-length",
+            str(STEP_LENGTH_S),
+            "--no-step-log",
+            "true",
+            "--no-warnings",
+            "true",
+            "--collision.action",
+            "remove",
+            "--collision.check-junctions",
+            "true",
+            "--collision.mingap-factor",
+            "0",
+            "--save-state.rng",
+            "true",
+            "--time-to-teleport",
+            "300",
         ]
 
     def _state_file(self, level: float, seed: int) -> Path:
@@ -353,8 +375,13 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         model = self.config.ego_model
         type_id = EGO_TYPE_ID if model == "agent" else BASELINE_EGO_TYPES[model]
         api.vehicle.add(
-            EGO_ID, EGO_ROUTE_ID, typeID=type_id, depart="now",
-            departLane="best", departPos="base", departSpeed="0",
+            EGO_ID,
+            EGO_ROUTE_ID,
+            typeID=type_id,
+            depart="now",
+            departLane="best",
+            departPos="base",
+            departSpeed="0",
         )
         for waited in range(self.config.insert_timeout_s):
             api.simulationStep()
@@ -434,7 +461,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             length = self._leader_len.get(lid)
             if length is None:
                 length = self._leader_len[lid] = float(api.vehicle.getLength(lid))
-            real = _Leader(max(float(lead[1]), 0.0), float(api.vehicle.getSpeed(lid)), length, False)
+            real = _Leader(
+                max(float(lead[1]), 0.0), float(api.vehicle.getSpeed(lid)), length, False
+            )
         leader = real
 
         d_tl, tls = rng, S.LightState.GREEN

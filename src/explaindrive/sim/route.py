@@ -139,9 +139,7 @@ def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGe
         crossed = set((edge.get("crossingEdges") or "").split())
         cid = edge.attrib["id"]
         node_id = cid[1:].rsplit("_", 1)[0]
-        route_in = [
-            e for e in route_edges[:-1] if edge_to[e] == node_id
-        ]
+        route_in = [e for e in route_edges[:-1] if edge_to[e] == node_id]
         if not crossed & set(route_edges) or not route_in:
             continue
         walk = sorted(

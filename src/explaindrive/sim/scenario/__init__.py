@@ -1,4 +1,4 @@
-"""The urban scenario: its layout (:mod:`.layout`), how it is built (:mod:`.build`) and its files."""
+"""The urban scenario: its layout, how it is built, and its files."""
 
 from explaindrive.sim.scenario.files import ScenarioFiles, default_scenario
 

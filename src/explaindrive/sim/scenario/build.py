@@ -44,12 +44,21 @@ def edges_xml() -> str:
         for eid, a, b in ((road.forward, road.a, road.b), (road.backward, road.b, road.a)):
             if road.kind == "footpath":
                 attrs = _attrs(
-                    id=eid, **{"from": a}, to=b, numLanes=1, speed=f"{road.speed_mps:.4f}",
-                    allow="pedestrian", width=layout.SIDEWALK_WIDTH_M,
+                    id=eid,
+                    **{"from": a},
+                    to=b,
+                    numLanes=1,
+                    speed=f"{road.speed_mps:.4f}",
+                    allow="pedestrian",
+                    width=layout.SIDEWALK_WIDTH_M,
                 )
             else:
                 attrs = _attrs(
-                    id=eid, **{"from": a}, to=b, numLanes=1, speed=f"{road.speed_mps:.4f}",
+                    id=eid,
+                    **{"from": a},
+                    to=b,
+                    numLanes=1,
+                    speed=f"{road.speed_mps:.4f}",
                     priority=2 if road.a in layout.EGO_ROUTE_NODES else 1,
                     sidewalkWidth=layout.SIDEWALK_WIDTH_M,
                 )
@@ -64,7 +73,10 @@ def connections_xml() -> str:
     for node, edges in layout.CROSSINGS:
         signalized = any(n.id == node and n.type == "traffic_light" for n in layout.NODES)
         attrs = _attrs(
-            node=node, edges=" ".join(edges), priority="true", width=4.0,
+            node=node,
+            edges=" ".join(edges),
+            priority="true",
+            width=4.0,
         )
         note = "signalized" if signalized else "zebra"
         lines.append(f"    <crossing {attrs}/> <!-- {note} -->")
@@ -90,19 +102,32 @@ def netconvert_args(files: dict[str, Path], net_file: Path) -> list[str]:
     """Command line for netconvert."""
     return [
         sumo_binary("netconvert"),
-        "--node-files", str(files["nodes"]),
-        "--edge-files", str(files["edges"]),
-        "--connection-files", str(files["connections"]),
-        "--output-file", str(net_file),
-        "--no-turnarounds", "true",
-        "--tls.default-type", "static",
-        "--tls.cycle.time", str(layout.TLS_CYCLE_S),
-        "--tls.yellow.time", str(layout.TLS_YELLOW_S),
-        "--tls.left-green.time", "0",
-        "--walkingareas", "true",
-        "--junctions.corner-detail", "5",
-        "--no-warnings", "true",
-        "--output.street-names", "false",
+        "--node-files",
+        str(files["nodes"]),
+        "--edge-files",
+        str(files["edges"]),
+        "--connection-files",
+        str(files["connections"]),
+        "--output-file",
+        str(net_file),
+        "--no-turnarounds",
+        "true",
+        "--tls.default-type",
+        "static",
+        "--tls.cycle.time",
+        str(layout.TLS_CYCLE_S),
+        "--tls.yellow.time",
+        str(layout.TLS_YELLOW_S),
+        "--tls.left-green.time",
+        "0",
+        "--walkingareas",
+        "true",
+        "--junctions.corner-detail",
+        "5",
+        "--no-warnings",
+        "true",
+        "--output.street-names",
+        "false",
     ]
 
 

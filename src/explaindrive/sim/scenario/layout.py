@@ -20,6 +20,7 @@ direction plus sidewalks) from ``W0`` to ``E0``::
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import pairwise
 
 KMH = 1.0 / 3.6  # [m/s per km/h]
 
@@ -65,7 +66,7 @@ class Flow:
     @property
     def edges(self) -> tuple[str, ...]:
         """Edge ids of the route."""
-        return tuple(f"{a}_{b}" for a, b in zip(self.nodes, self.nodes[1:], strict=False))
+        return tuple(f"{a}_{b}" for a, b in pairwise(self.nodes))
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,9 +125,7 @@ CROSSINGS: tuple[tuple[str, tuple[str, ...]], ...] = (
 )
 
 EGO_ROUTE_NODES: tuple[str, ...] = ("W0", "J1", "Z1", "PX", "Z2", "J2", "E0")
-EGO_ROUTE_EDGES: tuple[str, ...] = tuple(
-    f"{a}_{b}" for a, b in zip(EGO_ROUTE_NODES, EGO_ROUTE_NODES[1:], strict=False)
-)
+EGO_ROUTE_EDGES: tuple[str, ...] = tuple(f"{a}_{b}" for a, b in pairwise(EGO_ROUTE_NODES))
 
 # Main-road eastbound demand at traffic level 1.0: one vehicle every 4 s.
 MAIN_DEMAND_VEH_PER_HOUR = 900.0

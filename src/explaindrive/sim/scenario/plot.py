@@ -43,8 +43,13 @@ def plot_network(net_file: Path, out_file: Path) -> Path:
             x, y = node.getCoord()
             ax.annotate(node.getID(), (x, y), xytext=(x + 8, y + 18), fontsize=9)
     start = net.getEdge(EGO_ROUTE_EDGES[0]).getShape()[0]
-    ax.annotate("ego start", start, xytext=(start[0], start[1] - 25), fontsize=9,
-                arrowprops={"arrowstyle": "->"})
+    ax.annotate(
+        "ego start",
+        start,
+        xytext=(start[0], start[1] - 25),
+        fontsize=9,
+        arrowprops={"arrowstyle": "->"},
+    )
     handles = [
         plt.Line2D([], [], color=zone_colour[50], lw=2.2, label="ego route, 50 km/h"),
         plt.Line2D([], [], color=zone_colour[30], lw=2.2, label="ego route, 30 km/h"),
