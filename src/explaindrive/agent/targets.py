@@ -7,7 +7,7 @@ hand (``tests/agent/test_targets.py``).
 from __future__ import annotations
 
 import torch
-import torch.nn.functional as F  # noqa: N812
+import torch.nn.functional as F
 from torch import Tensor
 
 
