@@ -20,6 +20,8 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "explaindrive.cli.demo",
     "explaindrive.cli.scenario",
     "explaindrive.cli.train",
+    "explaindrive.cli.evaluate",
+    "explaindrive.cli.report",
 )
 
 

@@ -1,0 +1,11 @@
+"""Evaluation suite: episode grids, parallel runners, aggregates, tables, figures and the report.
+
+- :mod:`~explaindrive.evaluation.spec`: policies, seeds, traffic levels and command schedules;
+- :mod:`~explaindrive.evaluation.runner`: one episode, and grids on a process pool or Ray;
+- :mod:`~explaindrive.evaluation.aggregate`: aggregation maths (pure functions);
+- :mod:`~explaindrive.evaluation.schema`: the JSON result file;
+- :mod:`~explaindrive.evaluation.tables`: Markdown tables in the paper's layout;
+- :mod:`~explaindrive.evaluation.figures`: speed profiles and training curves;
+- :mod:`~explaindrive.evaluation.paper`: the paper's reported numbers (the only copy);
+- :mod:`~explaindrive.evaluation.report`: ``docs/results.md``.
+"""

@@ -1,0 +1,129 @@
+"""The JSON result file of an evaluation (documented in ``docs/evaluation.md``).
+
+Layout (``version`` 1)::
+
+    {
+      "schema": "explaindrive-evaluation", "version": 1,
+      "created_utc": "...", "explaindrive_version": "...",
+      "runs": [
+        {
+          "name": "fast", "policy": {...PolicySpec...},
+          "command": "fast", "schedule": [[60.0, "stop"], [75.0, "fast"]],
+          "seeds": [0, 1], "traffic_levels": [0.5, 1.0], "max_steps": 1000,
+          "aggregates": {"overall": {...Aggregate...}, "by_level": {"0.5": {...}, ...}},
+          "paper": {...PaperRow...} | null,
+          "episodes": [
+            {"seed": 0, "traffic_level": 0.5, "metrics": {...EpisodeResult...},
+             "trace": {"speed_mps": [...], "command": [...]}}
+          ]
+        }
+      ]
+    }
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Sequence
+from datetime import UTC, datetime
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+from explaindrive.evaluation.aggregate import aggregate, aggregate_by_level
+from explaindrive.evaluation.paper import paper_row
+from explaindrive.evaluation.runner import EpisodeRecord
+
+SCHEMA_NAME = "explaindrive-evaluation"
+SCHEMA_VERSION = 1
+
+
+def _unique(values: Sequence[Any]) -> list[Any]:
+    return list(dict.fromkeys(values))
+
+
+def _finite(value: Any) -> Any:
+    """JSON has no inf/nan: map them to ``None`` recursively."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
+
+
+def episode_document(record: EpisodeRecord, include_trace: bool = True) -> dict[str, Any]:
+    """JSON-ready dict of one episode."""
+    doc: dict[str, Any] = {
+        "seed": record.spec.seed,
+        "traffic_level": record.spec.traffic_level,
+        "metrics": record.result.as_dict(),
+    }
+    if include_trace:
+        doc["trace"] = {"speed_mps": list(record.speeds_mps), "command": list(record.commands)}
+    return doc
+
+
+def run_document(
+    name: str, records: Sequence[EpisodeRecord], include_traces: bool = True
+) -> dict[str, Any]:
+    """JSON-ready dict of one run: a policy under one schedule over a seed x level grid.
+
+    Raises:
+        ValueError: if ``records`` is empty or mixes policies or schedules.
+    """
+    if not records:
+        raise ValueError(f"run {name!r} has no episodes")
+    first = records[0].spec
+    for rec in records:
+        if (rec.spec.policy, rec.spec.command, rec.spec.schedule) != (
+            first.policy, first.command, first.schedule,
+        ):  # fmt: skip
+            raise ValueError(f"run {name!r} mixes policies or command schedules")
+    by_level = aggregate_by_level([(r.spec.traffic_level, r.result) for r in records])
+    paper = paper_row(name)
+    return {
+        "name": name,
+        "policy": first.policy.as_dict(),
+        "command": first.command,
+        "schedule": [[t, c] for t, c in first.schedule],
+        "seeds": _unique([r.spec.seed for r in records]),
+        "traffic_levels": _unique([r.spec.traffic_level for r in records]),
+        "max_steps": first.max_steps,
+        "aggregates": {
+            "overall": aggregate([r.result for r in records]).as_dict(),
+            "by_level": {f"{level:g}": agg.as_dict() for level, agg in by_level.items()},
+        },
+        "paper": dataclasses.asdict(paper) if paper else None,
+        "episodes": [episode_document(r, include_traces) for r in records],
+    }
+
+
+def evaluation_document(runs: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """The whole file: header plus ``runs`` (from :func:`run_document`)."""
+    try:
+        version = metadata.version("explaindrive")
+    except metadata.PackageNotFoundError:
+        version = "unknown"
+    return _finite(
+        {
+            "schema": SCHEMA_NAME,
+            "version": SCHEMA_VERSION,
+            "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+            "explaindrive_version": version,
+            "runs": list(runs),
+        }
+    )
+
+
+def write_json(path: Path, runs: Sequence[dict[str, Any]]) -> Path:
+    """Write :func:`evaluation_document` of ``runs`` to ``path`` (parents created)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    doc = evaluation_document(runs)
+    # Paper rows have float keys; JSON object keys become strings.
+    path.write_text(json.dumps(doc, indent=1, allow_nan=False, default=str) + "\n", "utf-8")
+    return path
