@@ -1,0 +1,51 @@
+"""Typed settings of a ride."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from explaindrive.sim.scenario.layout import validate_traffic_level
+
+
+@dataclass(frozen=True, slots=True)
+class RideConfig:
+    """Settings of :class:`~explaindrive.ride.session.RideSession`.
+
+    Attributes:
+        traffic_level: demand scale (1.0 = 900 veh/h on the main road).
+        seed: simulation seed.
+        max_steps: longest ride [steps of 1 s].
+        backend: language backend (``embedded`` or ``openai``).
+        auto_confirm: answer every confirmation question with yes.
+        stop_without_confirm: apply a STOP request as soon as it is understood.
+        explanation_cooldown_s: an explanation for the same reason is repeated only
+            after this long [s]; a new reason is explained at once.
+        interpret_deadline_s: wall-time budget of transcription + interpretation [s].
+        explain_deadline_s: wall-time budget of one decision or explanation [s].
+        realtime: pace the ride at one step per second.
+        gui: show the ride in sumo-gui.
+    """
+
+    traffic_level: float = 1.0
+    seed: int = 0
+    max_steps: int = 600
+    backend: str = "embedded"
+    auto_confirm: bool = False
+    stop_without_confirm: bool = False
+    explanation_cooldown_s: float = 15.0
+    interpret_deadline_s: float = 2.0
+    explain_deadline_s: float = 1.0
+    realtime: bool = False
+    gui: bool = False
+
+    def __post_init__(self) -> None:
+        validate_traffic_level(self.traffic_level)
+        if self.max_steps <= 0:
+            raise ValueError(f"max_steps must be > 0, got {self.max_steps}")
+        if not 0 <= self.seed < 2**31:
+            raise ValueError(f"seed must be in [0, 2**31), got {self.seed}")
+        for name in ("explanation_cooldown_s", "interpret_deadline_s", "explain_deadline_s"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
+        if self.backend not in ("embedded", "openai"):
+            raise ValueError(f"backend must be 'embedded' or 'openai', got {self.backend!r}")

@@ -1,0 +1,85 @@
+"""Test doubles for a ride: a scripted controller and scripted language modules."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from explaindrive.commands import Command
+from explaindrive.env.scripted import CautiousDriver
+from explaindrive.env.state import CMD
+from explaindrive.language.decision import Conflict, Decision, ExplanationDecider, Factor
+from explaindrive.language.explanation import Explainer, Explanation
+from explaindrive.language.intent import IntentInterpreter, IntentResult, format_confirmation
+from explaindrive.language.summary import StateRecord
+from explaindrive.ride.language import LanguageStack
+
+
+class ScriptedController:
+    """The merged-controller interface over the cautious rule-based driver."""
+
+    def __init__(self) -> None:
+        self.command = Command.FAST
+        self.active_agent = Command.FAST
+        self.driver = CautiousDriver()
+
+    def set_command(self, command: Command | str) -> None:
+        cmd = Command.parse(command)
+        if cmd is not Command.STOP:
+            self.active_agent = cmd
+        self.command = cmd
+
+    def observation(self, obs: np.ndarray) -> np.ndarray:
+        x = np.array(obs, dtype=np.float32)
+        x[CMD] = float(self.command)
+        return x
+
+    def act(self, obs: np.ndarray) -> int:
+        return self.driver(obs)
+
+
+class KeywordInterpreter(IntentInterpreter):
+    """Maps keywords to commands; ``slow`` in the text makes it sleep, ``crash`` raise."""
+
+    name = "fake"
+    words = {"hurry": Command.FAST, "stop": Command.STOP, "gently": Command.COMFORT}
+
+    def __init__(self, delay_s: float = 0.0) -> None:
+        self.delay_s = delay_s
+
+    def interpret(self, text: str) -> IntentResult:
+        if "crash" in text:
+            raise RuntimeError("model exploded")
+        if "slow" in text:
+            time.sleep(self.delay_s)
+        intent = next((c for w, c in self.words.items() if w in text.lower()), None)
+        question = format_confirmation(intent) if intent is not None else "Could you rephrase?"
+        return IntentResult(intent, question, self.name, False, 0.0, {})
+
+
+class BrakingDecider(ExplanationDecider):
+    """Explains every deceleration under fast, naming the traffic light."""
+
+    name = "fake"
+
+    def decide(self, record: StateRecord) -> Decision:
+        explain = record.request == "fast" and record.action < 0
+        factor = Factor.TRAFFIC_LIGHT if explain else None
+        conflict = Conflict.SLOWS if explain else Conflict.NONE
+        return Decision(explain, factor, conflict, "test", self.name)
+
+
+class EchoExplainer(Explainer):
+    name = "fake"
+
+    def explain(self, record: StateRecord, factor: Factor | None) -> Explanation:
+        return Explanation(f"slowing for {factor}", factor, self.name)
+
+
+def fake_language(delay_s: float = 0.0) -> LanguageStack:
+    def transcribe(path: Path) -> str:
+        return path.stem.replace("_", " ")
+
+    return LanguageStack(KeywordInterpreter(delay_s), BrakingDecider(), EchoExplainer(), transcribe)

@@ -1,0 +1,59 @@
+"""Ride scripts: parsing and the errors a user sees."""
+
+from pathlib import Path
+
+import pytest
+
+from explaindrive.ride.script import ScriptError, default_script_path, load_script
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_yaml_script_is_sorted_and_resolves_audio(tmp_path):
+    path = write(
+        tmp_path, "s.yaml", "- {t: 30, audio: a.wav}\n- {t: 0, say: hurry, confirm: yes}\n"
+    )
+    lines = load_script(path)
+    assert [ln.t for ln in lines] == [0.0, 30.0]
+    assert lines[0].say == "hurry" and lines[0].confirm == "yes"
+    assert lines[1].audio == tmp_path / "a.wav"
+
+
+def test_json_script_with_lines_key(tmp_path):
+    path = write(tmp_path, "s.json", '{"lines": [{"t": 5, "say": "stop", "confirm": "no"}]}')
+    (line,) = load_script(path)
+    assert (line.t, line.say, line.confirm) == (5.0, "stop", "no")
+
+
+def test_default_script_exercises_fast_stop_comfort():
+    lines = load_script(default_script_path())
+    assert [ln.t for ln in lines] == [0.0, 60.0, 80.0]
+    assert all(ln.confirm == "yes" for ln in lines)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("- {t: 1, say: hi, volume: 3}\n", "line 1: volume: Extra inputs are not permitted"),
+        ("- {t: 1}\n", "exactly one of 'say' or 'audio'"),
+        ("- {t: -1, say: hi}\n", "line 1: t: Input should be greater than or equal to 0"),
+        ("- {t: 1, say: hi, confirm: maybe}\n", "line 1: confirm"),
+        ("- {t: 900, say: hi}\n", "t=900 s is after the end of the ride (600 s)"),
+        ("{t: 1, say: hi}\n", "must be a list of lines"),
+        ("- [unclosed\n", "is not valid YAML/JSON"),
+    ],
+)
+def test_bad_scripts_are_refused_clearly(tmp_path, text, message):
+    path = write(tmp_path, "bad.yaml", text)
+    with pytest.raises(ScriptError, match="bad.yaml") as err:
+        load_script(path, max_time_s=600)
+    assert message in str(err.value)
+
+
+def test_unreadable_script(tmp_path):
+    with pytest.raises(ScriptError, match="cannot read ride script"):
+        load_script(tmp_path / "missing.yaml")

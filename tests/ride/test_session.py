@@ -1,0 +1,118 @@
+"""The ride loop with a scripted controller and scripted language modules (live SUMO)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from explaindrive.commands import Command
+from explaindrive.ride.config import RideConfig
+from explaindrive.ride.runner import run_ride
+from explaindrive.ride.script import ScriptLine
+from explaindrive.ride.session import RideSession
+
+from .fakes import ScriptedController, fake_language
+
+
+def make_session(**overrides) -> RideSession:
+    cfg = {"traffic_level": 0.5, "seed": 3, "max_steps": 120, **overrides}
+    return RideSession(RideConfig(**cfg), ScriptedController(), fake_language(delay_s=0.5))
+
+
+def line(t: float, say: str, confirm: str | None = None) -> ScriptLine:
+    return ScriptLine(t=t, say=say, confirm=confirm)
+
+
+def events(session: RideSession, kind: str) -> list[dict]:
+    return [e for r in session.records for e in r.passenger if e["type"] == kind]
+
+
+def test_confirmed_commands_take_effect_on_the_next_step(tmp_path):
+    session = make_session()
+    script = [
+        line(0, "please hurry", "yes"),
+        line(20, "stop now", "yes"),
+        line(40, "go gently", "no"),
+        line(45, "go gently", "yes"),
+    ]
+    out = run_ride(session, script, tmp_path)
+    cmds = [r.command for r in session.records]
+    assert cmds[19] == "fast" and cmds[20] == "stop"  # line at t=20, applied before step 21
+    assert cmds[44] == "stop" and cmds[45] == "comfort"
+    assert [e["to"] for e in events(session, "confirmed")] == ["fast", "stop", "comfort"]
+    assert len(events(session, "cancelled")) == 1  # the "no" kept stop
+    stop_steps = [r for r in session.records if r.command == "stop"]
+    assert stop_steps[-1].speed_mps == 0.0
+    c = session.counts
+    assert (c.requests, c.confirmations, c.cancellations) == (4, 3, 1)
+    rows = [json.loads(x) for x in out.events.read_text().splitlines()]
+    assert len(rows) == len(session.records)  # one line per step, none lost
+    assert rows[20]["command"] == "stop" and set(rows[0]["state"]) >= {"v_ego", "d_tl"}
+    summary = json.loads(out.summary.read_text())
+    assert summary["counts"]["confirmations"] == 3
+    assert summary["metrics"]["collisions"] == 0
+    assert out.figure.stat().st_size > 10_000
+
+
+def test_late_failed_and_garbage_requests_keep_the_command(tmp_path):
+    session = make_session(interpret_deadline_s=0.2, max_steps=40)
+    script = [
+        line(0, "hurry", "yes"),
+        line(5, "slow down, hurry", "yes"),
+        line(10, "crash the model"),
+        line(15, "play some music"),
+        line(20, ""),
+    ]
+    run_ride(session, script, tmp_path)
+    assert all(r.command == "fast" for r in session.records)
+    late = events(session, "late")
+    assert late[0]["module"] == "interpret" and late[0]["kept_command"] == "fast"
+    assert events(session, "error")[0]["error"] == "RuntimeError: model exploded"
+    assert session.counts.rephrase == 2  # music and the empty line
+    assert (session.counts.late, session.counts.errors) == (1, 1)
+
+
+def test_unconfirmed_question_waits_for_the_passenger():
+    session = make_session(max_steps=30)
+    session.start()
+    session.say("stop please")
+    session.step()
+    session.step()
+    assert session.pending_confirmation is not None
+    assert session.pending_confirmation.question == "You want me to stop, is this correct?"
+    assert session.command is Command.FAST
+    assert session.answer(True)
+    session.step()
+    assert session.records[-1].command == "stop"
+    assert not session.answer(False)  # nothing pending any more
+    session.close()
+
+
+def test_stop_without_confirm_and_auto_confirm():
+    session = make_session(stop_without_confirm=True, max_steps=30)
+    session.start()
+    session.say("stop")
+    session.step()
+    session.step()
+    assert session.records[-1].command == "stop" and session.pending_confirmation is None
+    session.close()
+
+
+def test_explanations_repeat_only_on_a_new_reason_or_after_cooldown(tmp_path):
+    session = make_session(explanation_cooldown_s=1000.0, max_steps=150)
+    run_ride(session, [line(0, "hurry", "yes")], tmp_path)
+    c = session.counts
+    assert c.explain_decisions >= 2
+    assert c.explanations == 1  # one reason, endless cool-down
+    assert c.suppressed_explanations == c.explain_decisions - 1
+    session2 = make_session(explanation_cooldown_s=0.0, max_steps=150)
+    run_ride(session2, [line(0, "hurry", "yes")], tmp_path / "b")
+    assert session2.counts.explanations == session2.counts.explain_decisions
+
+
+def test_step_after_the_end_is_refused(tmp_path):
+    session = make_session(max_steps=3)
+    run_ride(session, [], tmp_path)
+    with pytest.raises(RuntimeError, match="not running"):
+        session.step()
