@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -44,7 +45,11 @@ class KeywordInterpreter(IntentInterpreter):
     """Maps keywords to commands; ``slow`` in the text makes it sleep, ``crash`` raise."""
 
     name = "fake"
-    words = {"hurry": Command.FAST, "stop": Command.STOP, "gently": Command.COMFORT}
+    words: ClassVar[dict[str, Command]] = {
+        "hurry": Command.FAST,
+        "stop": Command.STOP,
+        "gently": Command.COMFORT,
+    }
 
     def __init__(self, delay_s: float = 0.0) -> None:
         self.delay_s = delay_s

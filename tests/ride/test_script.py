@@ -49,7 +49,7 @@ def test_default_script_exercises_fast_stop_comfort():
 )
 def test_bad_scripts_are_refused_clearly(tmp_path, text, message):
     path = write(tmp_path, "bad.yaml", text)
-    with pytest.raises(ScriptError, match="bad.yaml") as err:
+    with pytest.raises(ScriptError, match=r"bad\.yaml") as err:
         load_script(path, max_time_s=600)
     assert message in str(err.value)
 
