@@ -42,7 +42,7 @@ def paper_table(summaries: Sequence[RunSummary], with_paper: bool = True) -> str
     """The paper's results table: one row per run, followed by the paper's row if it has one."""
     levels = _levels(summaries)
     header = [
-        "policy", f"steps ({'/'.join(f'{x:g}' for x in levels)})", "mean speed m/s",
+        "policy", f"steps ({'/'.join(str(float(x)) for x in levels)})", "mean speed m/s",
         "avg TH s", "avg TTC s", "avg jerk m/s^3", "AV collisions",
     ]  # fmt: skip
     rows: list[list[str]] = []
