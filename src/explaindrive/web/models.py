@@ -1,0 +1,66 @@
+"""Typed, validated request bodies of the web API (unknown fields are rejected)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+from explaindrive.sim.scenario.layout import validate_traffic_level
+
+MAX_TEXT_CHARS = 300  # a spoken request is a sentence or two
+MAX_RIDE_STEPS = 1800  # [s] half an hour of driving
+MAX_TRAFFIC_LEVEL = 3.0  # twice the busiest level the paper evaluates
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class StartRequest(_Strict):
+    """Start a new ride.
+
+    Attributes:
+        traffic_level: demand scale, in (0, 3] (1.0 = 900 veh/h on the main road).
+        seed: simulation seed; the same seed and level give the same traffic.
+        command: the command the car starts with.
+        max_steps: longest ride [s].
+    """
+
+    traffic_level: float = Field(default=1.0, gt=0, le=MAX_TRAFFIC_LEVEL)
+    seed: int = Field(default=0, ge=0, lt=2**31)
+    command: Literal["fast", "comfort", "stop"] = "comfort"
+    max_steps: int = Field(default=600, gt=0, le=MAX_RIDE_STEPS)
+
+    @field_validator("traffic_level")
+    @classmethod
+    def _known_level(cls, value: float) -> float:
+        return validate_traffic_level(value)
+
+
+class SayRequest(_Strict):
+    """A typed passenger line.
+
+    Attributes:
+        text: what the passenger says (surrounding white space is removed).
+    """
+
+    text: str = Field(min_length=1, max_length=MAX_TEXT_CHARS)
+
+    @field_validator("text")
+    @classmethod
+    def _not_blank(cls, value: str) -> str:
+        value = value.strip()
+        if not value:
+            raise ValueError("text must not be blank")
+        return value
+
+
+class AnswerRequest(_Strict):
+    """The passenger's answer to the confirmation question.
+
+    Attributes:
+        yes: ``true`` confirms the reformulated request, ``false`` cancels it.
+    """
+
+    yes: bool
