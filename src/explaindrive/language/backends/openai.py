@@ -1,0 +1,212 @@
+"""OpenAI-compatible backend (OpenAI, Ollama, vLLM, llama.cpp) with the paper's prompts.
+
+Every reply is validated (LLM-1 template, LLM-2 tag, LLM-3 grounding); a malformed
+reply, an HTTP error or a timeout falls back to the embedded module and the result
+says so (``fallback=True``, ``error=...``).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from typing import Any
+
+from explaindrive.language.backends.embedded import (
+    EmbeddedIntentInterpreter,
+    RuleDecider,
+    TemplateExplainer,
+)
+from explaindrive.language.config import OpenAIConfig
+from explaindrive.language.decision import (
+    Decision,
+    ExplanationDecider,
+    Factor,
+    detect_conflict,
+    most_critical_factor,
+    parse_decision_tag,
+)
+from explaindrive.language.explanation import Explainer, Explanation, check_grounding
+from explaindrive.language.intent import IntentInterpreter, IntentResult, parse_confirmation
+from explaindrive.language.summary import StateRecord, describe_action, environment_summary
+
+log = logging.getLogger(__name__)
+
+NAME = "openai"
+
+# The paper's prompts, verbatim (section 4).
+INTENT_PROMPT = (
+    "You are an autonomous taxi's AI assistant. Reformulate the passenger's request into a "
+    "direct instruction about how the vehicle should drive. The instruction must correspond "
+    "to one of the following driving styles: drive faster, drive more carefully, or stop. At "
+    'the end, confirm the reformulation using the following format: "You want me to '
+    '[action], is this correct?" Do not provide multiple options or add any extra text. Only '
+    "output the direct confirmation question."
+)
+DECISION_PROMPT = """You are an AI reasoning module for an autonomous taxi. Your task is to output exactly ONE of:
+- [EXPLAIN]
+- [NO EXPLANATION NEEDED]
+
+Principles to decide:
+
+1) Return [EXPLAIN] only if the vehicle’s present action clearly conflicts
+or delays the user’s request for a clear safety reason (e.g., decelerating
+when asked for driving faster, or harsh acceleration or deceleration when
+asked for a comfortable ride).
+
+2) Return [NO EXPLANATION NEEDED] for behavior that is ordinary, supportive,
+or neutral with respect to the request (e.g., maintaining speed when user
+asked for comfort, smooth acceleration/braking).
+
+3) Multiple reasons: If several safety reasons exist, internally consider
+the most safety-critical one.
+Output only the tag. Do not include any justification or text besides the
+tag."""  # noqa: E501
+EXPLAIN_PROMPT = """You are an AI assistant inside an autonomous taxi. Your job is to explain
+to the passenger why the vehicle’s action seems to contradict their request.
+When that happens, briefly explain the most safety-relevant nearby reason
+for the vehicle’s behavior, using a friendly and reassuring tone. Keep
+it concise."""
+
+_REQUEST_TEXT = {"fast": "drive faster", "comfort": "drive more carefully", "stop": "stop"}
+MAX_EXPLANATION_CHARS = 400
+
+
+class BackendReplyError(RuntimeError):
+    """The endpoint answered, but not in the required format."""
+
+
+def situation_message(record: StateRecord, cutoff_m: float) -> str:
+    """The user message of LLM-2/LLM-3: request, action and environment summary."""
+    return (
+        f"Passenger request: {_REQUEST_TEXT[record.request]}\n"
+        f"Vehicle action: {describe_action(record.action)}\n"
+        f"Environment: {environment_summary(record, cutoff_m)}"
+    )
+
+
+class ChatClient:
+    """Thin wrapper over the official ``openai`` SDK's chat completions."""
+
+    def __init__(self, config: OpenAIConfig) -> None:
+        """Args: config: endpoint, model, timeout and retries."""
+        from openai import OpenAI
+
+        self.config = config
+        self._client = OpenAI(
+            api_key=config.api_key or os.environ.get("OPENAI_API_KEY") or "not-needed",
+            base_url=config.base_url or os.environ.get("OPENAI_BASE_URL") or None,
+            timeout=config.timeout_s,
+            max_retries=config.max_retries,
+        )
+
+    def complete(self, system: str, user: str, temperature: float) -> str:
+        """One chat completion; returns the reply text.
+
+        Raises:
+            BackendReplyError: on an empty reply.
+            openai.OpenAIError: on HTTP errors and timeouts.
+        """
+        resp: Any = self._client.chat.completions.create(
+            model=self.config.model,
+            messages=[{"role": "system", "content": system}, {"role": "user", "content": user}],
+            temperature=temperature,
+            max_tokens=self.config.max_tokens,
+        )
+        if not resp.choices or resp.choices[0].message.content is None:
+            raise BackendReplyError("empty reply")
+        return str(resp.choices[0].message.content)
+
+
+def _err(exc: Exception) -> str:
+    return f"{type(exc).__name__}: {exc}"[:300]
+
+
+class OpenAIIntentInterpreter(IntentInterpreter):
+    """LLM-1 through the endpoint; falls back to the embedded interpreter."""
+
+    name = NAME
+
+    def __init__(self, client: ChatClient, fallback: EmbeddedIntentInterpreter) -> None:
+        """Args: client: the chat client; fallback: the embedded interpreter."""
+        self.client = client
+        self.fallback = fallback
+
+    def interpret(self, text: str) -> IntentResult:
+        """Ask the endpoint; the reply must be exactly the confirmation template."""
+        t0 = time.perf_counter()
+        try:
+            reply = self.client.complete(INTENT_PROMPT, text, self.client.config.intent_temperature)
+            command = parse_confirmation(reply)
+            if command is None:
+                raise BackendReplyError(f"reply does not follow the template: {reply[:120]!r}")
+            return IntentResult(command, reply.strip().strip("\"'"), NAME, False,
+                                time.perf_counter() - t0, {})
+        except Exception as exc:  # any endpoint failure: answer offline instead
+            log.warning("openai intent failed, using embedded: %s", _err(exc))
+            r = self.fallback.interpret(text)
+            return IntentResult(r.intent, r.confirmation, r.backend, True,
+                                time.perf_counter() - t0, r.scores, _err(exc))
+
+
+class OpenAIDecider(ExplanationDecider):
+    """LLM-2 through the endpoint; the factor comes from the grounded ranking."""
+
+    name = NAME
+
+    def __init__(self, client: ChatClient, fallback: RuleDecider) -> None:
+        """Args: client: the chat client; fallback: the rule engine."""
+        self.client = client
+        self.fallback = fallback
+
+    def decide(self, record: StateRecord) -> Decision:
+        """Ask for one tag; anything else falls back to the rule engine."""
+        t0 = time.perf_counter()
+        cutoff = self.fallback.config.cutoff_m
+        try:
+            reply = self.client.complete(DECISION_PROMPT, situation_message(record, cutoff),
+                                         self.client.config.decision_temperature)
+            explain = parse_decision_tag(reply)
+            if explain is None:
+                raise BackendReplyError(f"reply is not one tag: {reply[:120]!r}")
+            factor = most_critical_factor(record, cutoff) if explain else None
+            return Decision(explain, factor, detect_conflict(record, cutoff),
+                            f"endpoint replied {reply.strip()}", NAME,
+                            latency_s=time.perf_counter() - t0)
+        except Exception as exc:
+            log.warning("openai decision failed, using rules: %s", _err(exc))
+            d = self.fallback.decide(record)
+            return Decision(d.explain, d.factor, d.conflict, d.reason, d.backend, True,
+                            time.perf_counter() - t0, _err(exc))
+
+
+class OpenAIExplainer(Explainer):
+    """LLM-3 through the endpoint (temperature 0.2); ungrounded replies fall back."""
+
+    name = NAME
+
+    def __init__(self, client: ChatClient, fallback: TemplateExplainer) -> None:
+        """Args: client: the chat client; fallback: the template explainer."""
+        self.client = client
+        self.fallback = fallback
+
+    def explain(self, record: StateRecord, factor: Factor | None) -> Explanation:
+        """Ask for an explanation; it must be short and name only factors in the state."""
+        t0 = time.perf_counter()
+        cutoff = self.fallback.config.cutoff_m
+        factor = factor or most_critical_factor(record, cutoff)
+        try:
+            reply = self.client.complete(EXPLAIN_PROMPT, situation_message(record, cutoff),
+                                         self.client.config.explain_temperature).strip()
+            if not reply or len(reply) > MAX_EXPLANATION_CHARS:
+                raise BackendReplyError(f"explanation empty or too long ({len(reply)} chars)")
+            grounding = check_grounding(reply, None, record, cutoff)
+            if grounding.absent:
+                names = ", ".join(f.value for f in grounding.absent)
+                raise BackendReplyError(f"explanation names factors not in the state: {names}")
+            return Explanation(reply, factor, NAME, latency_s=time.perf_counter() - t0)
+        except Exception as exc:
+            log.warning("openai explanation failed, using templates: %s", _err(exc))
+            e = self.fallback.explain(record, factor)
+            return Explanation(e.text, e.factor, e.backend, True, time.perf_counter() - t0,
+                               _err(exc))

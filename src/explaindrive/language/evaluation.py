@@ -1,0 +1,145 @@
+"""Quantitative evaluation of LLM-1 (intents) and LLM-2/LLM-3 (decisions, explanations)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from sklearn.metrics import (
+    accuracy_score,
+    cohen_kappa_score,
+    confusion_matrix,
+    f1_score,
+    precision_recall_fscore_support,
+)
+
+from explaindrive.commands import COMMAND_LABELS
+from explaindrive.language.datasets import CommandExample, LabelledRecord
+from explaindrive.language.decision import ExplanationDecider
+from explaindrive.language.explanation import Explainer, check_grounding
+from explaindrive.language.intent import IntentInterpreter, is_template_compliant
+
+CONFUSION_LABELS: tuple[str, ...] = (*COMMAND_LABELS, "none")
+
+
+def _percentiles(values: list[float]) -> dict[str, float]:
+    if not values:
+        return {"p50_ms": 0.0, "p95_ms": 0.0}
+    arr = np.asarray(values) * 1000.0
+    return {"p50_ms": round(float(np.percentile(arr, 50)), 3),
+            "p95_ms": round(float(np.percentile(arr, 95)), 3)}
+
+
+def intent_metrics(truth: list[str], pred: list[str], confirmations: list[str | None]) -> dict[str, Any]:
+    """Metrics of LLM-1 from labels (``fast|comfort|stop|none``) and predictions.
+
+    The 3-class figures (accuracy, macro-F1, kappa, per class) use the rows whose true
+    label is a command; a ``none`` prediction on such a row counts as an error. Template
+    compliance is the share of those rows whose output is exactly the template question.
+    ``none_rejection`` is the share of ``none`` rows left without a command.
+    """
+    idx = [i for i, t in enumerate(truth) if t != "none"]
+    t3 = [truth[i] for i in idx]
+    p3 = [pred[i] for i in idx]
+    labels = list(COMMAND_LABELS)
+    prec, rec, f1, sup = precision_recall_fscore_support(
+        t3, p3, labels=labels, zero_division=0
+    )
+    none_idx = [i for i, t in enumerate(truth) if t == "none"]
+    return {
+        "n": len(truth),
+        "n_commands": len(idx),
+        "accuracy": round(float(accuracy_score(t3, p3)), 4),
+        "macro_f1": round(float(f1_score(t3, p3, labels=labels, average="macro",
+                                         zero_division=0)), 4),
+        "cohen_kappa": round(float(cohen_kappa_score(t3, p3)), 4),
+        "template_compliance": round(
+            float(np.mean([is_template_compliant(confirmations[i]) for i in idx])), 4
+        ) if idx else 0.0,
+        "per_class": {
+            name: {"precision": round(float(prec[k]), 4), "recall": round(float(rec[k]), 4),
+                   "f1": round(float(f1[k]), 4), "support": int(sup[k])}
+            for k, name in enumerate(labels)
+        },
+        "confusion": {
+            "labels": list(CONFUSION_LABELS),
+            "matrix": confusion_matrix(truth, pred, labels=list(CONFUSION_LABELS)).tolist(),
+        },
+        "none_rejection": round(float(np.mean([pred[i] == "none" for i in none_idx])), 4)
+        if none_idx else None,
+        "n_none": len(none_idx),
+    }
+
+
+def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample]) -> dict[str, Any]:
+    """Run ``interpreter`` over labelled requests; metrics plus every error and latency."""
+    preds: list[str] = []
+    confs: list[str | None] = []
+    latencies: list[float] = []
+    fallbacks = 0
+    errors = []
+    for row in rows:
+        r = interpreter.interpret(row.text)
+        label = r.intent.label if r.intent is not None else "none"
+        preds.append(label)
+        confs.append(r.confirmation)
+        latencies.append(r.latency_s)
+        fallbacks += r.fallback
+        if label != row.label:
+            errors.append({"text": row.text, "label": row.label, "pred": label, "kind": row.kind})
+    out = intent_metrics([r.label for r in rows], preds, confs)
+    out.update(errors=errors, fallbacks=fallbacks, latency=_percentiles(latencies))
+    return out
+
+
+def evaluate_decisions(
+    decider: ExplanationDecider, explainer: Explainer, rows: list[LabelledRecord]
+) -> dict[str, Any]:
+    """Trigger accuracy/precision/recall/F1, factor accuracy, and grounded explanations.
+
+    Factor accuracy is over the labelled ``explain`` rows that the decider also chose to
+    explain. Every explanation is checked: it names the labelled factor and no factor
+    absent from the state.
+    """
+    truth: list[bool] = []
+    pred: list[bool] = []
+    factor_hits: list[bool] = []
+    texts: list[dict[str, Any]] = []
+    lat_decide: list[float] = []
+    lat_explain: list[float] = []
+    fallbacks = 0
+    for row in rows:
+        rec = row.record()
+        d = decider.decide(rec)
+        truth.append(row.explain)
+        pred.append(d.explain)
+        lat_decide.append(d.latency_s)
+        fallbacks += d.fallback
+        if d.explain:
+            e = explainer.explain(rec, d.factor)
+            lat_explain.append(e.latency_s)
+            g = check_grounding(e.text, row.factor, rec)
+            texts.append({"id": row.id, "factor": d.factor.value if d.factor else None,
+                          "label_factor": row.factor.value if row.factor else None,
+                          "text": e.text, "names_factor": g.names_factor,
+                          "absent_factors": [f.value for f in g.absent], "grounded": g.ok})
+            if row.explain:
+                factor_hits.append(d.factor == row.factor)
+    prec, rec_, f1, _ = precision_recall_fscore_support(
+        truth, pred, average="binary", pos_label=True, zero_division=0
+    )
+    labelled = [t for t in texts if t["label_factor"] is not None]
+    return {
+        "n": len(rows),
+        "n_explain": int(sum(truth)),
+        "accuracy": round(float(accuracy_score(truth, pred)), 4),
+        "precision": round(float(prec), 4),
+        "recall": round(float(rec_), 4),
+        "f1": round(float(f1), 4),
+        "factor_accuracy": round(float(np.mean(factor_hits)), 4) if factor_hits else None,
+        "grounded_share": round(float(np.mean([t["grounded"] for t in labelled])), 4)
+        if labelled else None,
+        "fallbacks": fallbacks,
+        "latency": {"decide": _percentiles(lat_decide), "explain": _percentiles(lat_explain)},
+        "explanations": texts,
+    }

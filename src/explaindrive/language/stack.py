@@ -1,0 +1,63 @@
+"""One place that assembles the language layer for a backend."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from explaindrive.language.backends import check_backend
+from explaindrive.language.backends.embedded import (
+    EmbeddedIntentInterpreter,
+    RuleDecider,
+    TemplateExplainer,
+)
+from explaindrive.language.config import LanguageConfig
+from explaindrive.language.decision import ExplanationDecider
+from explaindrive.language.explanation import Explainer
+from explaindrive.language.intent import IntentInterpreter
+from explaindrive.language.speech import Transcriber
+
+
+@dataclass(frozen=True)
+class LanguageStack:
+    """The four modules the ride loop calls."""
+
+    backend: str
+    interpreter: IntentInterpreter
+    decider: ExplanationDecider
+    explainer: Explainer
+    transcriber: Transcriber
+
+
+def make_language_stack(backend: str | None = None, config: LanguageConfig | None = None) -> LanguageStack:
+    """Build interpreter, decider, explainer and transcriber for ``backend``.
+
+    Models load lazily (on first use); call ``stack.interpreter.load()`` /
+    ``stack.transcriber.load()`` to pay that cost up front.
+
+    Args:
+        backend: ``embedded`` or ``openai``; ``None`` = ``config.backend``.
+        config: the layer's configuration; ``None`` = defaults.
+
+    Raises:
+        ValueError: for an unknown backend name.
+    """
+    cfg = config or LanguageConfig()
+    name = check_backend(backend or cfg.backend)
+    interpreter: IntentInterpreter = EmbeddedIntentInterpreter(cfg.embedded)
+    decider: ExplanationDecider = RuleDecider(cfg.embedded)
+    explainer: Explainer = TemplateExplainer(cfg.embedded)
+    if name == "openai":
+        from explaindrive.language.backends.openai import (
+            ChatClient,
+            OpenAIDecider,
+            OpenAIExplainer,
+            OpenAIIntentInterpreter,
+        )
+
+        client = ChatClient(cfg.openai)
+        assert isinstance(interpreter, EmbeddedIntentInterpreter)
+        assert isinstance(decider, RuleDecider) and isinstance(explainer, TemplateExplainer)
+        interpreter = OpenAIIntentInterpreter(client, interpreter)
+        decider = OpenAIDecider(client, decider)
+        explainer = OpenAIExplainer(client, explainer)
+    return LanguageStack(name, interpreter, decider, explainer, Transcriber(cfg.speech))
