@@ -22,6 +22,11 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "explaindrive.cli.train",
     "explaindrive.cli.evaluate",
     "explaindrive.cli.report",
+    "explaindrive.cli.interpret",
+    "explaindrive.cli.explain",
+    "explaindrive.cli.transcribe",
+    "explaindrive.cli.eval_cmd",
+    "explaindrive.cli.eval_language",
 )
 
 

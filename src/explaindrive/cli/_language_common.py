@@ -1,0 +1,39 @@
+"""Shared helpers of the language CLI commands (backend option, JSON output, errors)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any, NoReturn
+
+import typer
+from rich.console import Console
+
+from explaindrive.language.config import LanguageConfig
+
+console = Console()
+err_console = Console(stderr=True)
+
+BACKEND_HELP = "Language backend: embedded (offline, default) or openai."
+CONFIG_HELP = "YAML language config (see docs/language.md)."
+
+
+def load_config(path: Path | None) -> LanguageConfig:
+    """The language config from ``path`` or the defaults; exits with a message on errors."""
+    if path is None:
+        return LanguageConfig()
+    try:
+        return LanguageConfig.from_yaml(path)
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+
+
+def fail(message: str, code: int = 2) -> NoReturn:
+    """Print an error on stderr and exit."""
+    err_console.print(f"[bold red]error:[/] {message}", highlight=False)
+    raise typer.Exit(code)
+
+
+def emit_json(data: Any) -> None:
+    """Print JSON on stdout, unstyled so scripts can parse it."""
+    print(json.dumps(data, indent=2, ensure_ascii=False))  # noqa: T201 - the CLI's own output

@@ -1,0 +1,98 @@
+"""``explaindrive eval intents|decisions``: evaluate LLM-1 and LLM-2/LLM-3 on labelled data."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.table import Table
+
+from explaindrive.cli._language_common import (
+    BACKEND_HELP,
+    CONFIG_HELP,
+    console,
+    fail,
+    load_config,
+)
+from explaindrive.cli.eval_cmd import eval_app
+from explaindrive.language.datasets import (
+    DECISIONS_JSONL,
+    TEST_CSV,
+    data_path,
+    load_commands,
+    load_decisions,
+)
+from explaindrive.language.evaluation import evaluate_decisions, evaluate_intents
+from explaindrive.language.stack import make_language_stack
+
+
+def _write(out: Path | None, data: dict[str, Any]) -> None:
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(data, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+        console.print(f"[dim]wrote {out}[/]")
+
+
+def intents_command(
+    data: Annotated[Path, typer.Option("--data", help="CSV text,label[,kind].")] = data_path(
+        TEST_CSV
+    ),
+    backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
+    out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
+    config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+) -> None:
+    """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
+    try:
+        rows = load_commands(data)
+        stack = make_language_stack(backend, load_config(config))
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+    report = evaluate_intents(stack.interpreter, rows)
+    report.update(backend=stack.backend, data=str(data))
+    table = Table(title=f"LLM-1 on {data.name} ({stack.backend})")
+    for col in ("class", "precision", "recall", "F1", "support"):
+        table.add_column(col, justify="right")
+    for name, m in report["per_class"].items():
+        table.add_row(name, f"{m['precision']:.3f}", f"{m['recall']:.3f}", f"{m['f1']:.3f}",
+                      str(m["support"]))
+    console.print(table)
+    console.print(
+        f"accuracy {report['accuracy']:.3f}  macro-F1 {report['macro_f1']:.3f}  "
+        f"kappa {report['cohen_kappa']:.3f}  template {report['template_compliance']:.3f}  "
+        f"none rejected {report['none_rejection']}  (n={report['n_commands']} + "
+        f"{report['n_none']} none; fallbacks {report['fallbacks']})"
+    )
+    _write(out, report)
+
+
+def decisions_command(
+    data: Annotated[Path, typer.Option("--data", help="JSONL of labelled records.")] = data_path(
+        DECISIONS_JSONL
+    ),
+    backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
+    out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
+    config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+) -> None:
+    """Trigger accuracy/precision/recall/F1, factor accuracy and grounding of LLM-2/LLM-3."""
+    try:
+        rows = load_decisions(data)
+        stack = make_language_stack(backend, load_config(config))
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+    report = evaluate_decisions(stack.decider, stack.explainer, rows)
+    report.update(backend=stack.backend, data=str(data))
+    console.print(
+        f"decisions ({stack.backend}, n={report['n']}): accuracy {report['accuracy']:.3f}  "
+        f"precision {report['precision']:.3f}  recall {report['recall']:.3f}  "
+        f"F1 {report['f1']:.3f}  factor accuracy {report['factor_accuracy']}  "
+        f"grounded {report['grounded_share']}  fallbacks {report['fallbacks']}"
+    )
+    _write(out, report)
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``intents`` and ``decisions`` to the ``eval`` group."""
+    eval_app.command("intents")(intents_command)
+    eval_app.command("decisions")(decisions_command)

@@ -1,0 +1,61 @@
+"""``explaindrive interpret "TEXT"``: LLM-1, a request to a command and its confirmation."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from explaindrive.cli._language_common import (
+    BACKEND_HELP,
+    CONFIG_HELP,
+    console,
+    emit_json,
+    fail,
+    load_config,
+)
+from explaindrive.language.speech import AudioError
+from explaindrive.language.stack import make_language_stack
+
+
+def interpret_command(
+    text: Annotated[str | None, typer.Argument(help="The passenger's request.")] = None,
+    audio: Annotated[Path | None, typer.Option("--audio", help="Transcribe this file.")] = None,
+    backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+) -> None:
+    """Map a passenger request (text or --audio) to fast, comfort, stop or no command."""
+    if (text is None) == (audio is None):
+        fail("give either TEXT or --audio FILE")
+    try:
+        stack = make_language_stack(backend, load_config(config))
+    except ValueError as exc:
+        fail(str(exc))
+    transcript = None
+    if audio is not None:
+        try:
+            transcript = stack.transcriber.transcribe(audio)
+        except (AudioError, FileNotFoundError) as exc:
+            fail(str(exc))
+        text = transcript.text
+    assert text is not None
+    result = stack.interpreter.interpret(text)
+    out = result.to_json()
+    if transcript is not None:
+        out["transcript"] = transcript.text
+    if as_json:
+        emit_json(out)
+        return
+    if transcript is not None:
+        console.print(f"[dim]heard:[/] {transcript.text}", highlight=False)
+    intent = out["intent"] or "none"
+    note = " [yellow](fallback)[/]" if result.fallback else ""
+    console.print(f"[bold]{intent}[/] via {result.backend}{note}", highlight=False)
+    console.print(str(result.confirmation), highlight=False)
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``interpret`` to the root command."""
+    app.command("interpret")(interpret_command)
