@@ -27,6 +27,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "explaindrive.cli.transcribe",
     "explaindrive.cli.eval_cmd",
     "explaindrive.cli.eval_language",
+    "explaindrive.cli.serve",
 )
 
 

@@ -1,0 +1,46 @@
+"""``explaindrive serve``: the passenger web interface."""
+
+from __future__ import annotations
+
+import typer
+from rich.console import Console
+
+console = Console()
+
+
+def serve(
+    host: str = typer.Option(
+        "127.0.0.1", "--host", help="Address to bind (local only by default)."
+    ),
+    port: int = typer.Option(8000, "--port", min=1, max=65535, help="TCP port."),
+    backend: str = typer.Option(
+        "embedded", "--backend", help="Language backend: embedded or openai."
+    ),
+    step_period: float = typer.Option(
+        1.0,
+        "--step-period",
+        min=0.05,
+        max=10.0,
+        help="Seconds of wall time per 1 s control step (1 = real time).",
+    ),
+) -> None:
+    """Serve the passenger page: watch the ride, talk to the car, read its explanations."""
+    import uvicorn
+
+    from explaindrive.web import create_app
+
+    if backend not in ("embedded", "openai"):
+        console.print(f"[red]error:[/red] unknown backend {backend!r}; use embedded or openai")
+        raise typer.Exit(2)
+    if host not in ("127.0.0.1", "localhost", "::1"):
+        console.print(
+            f"[yellow]warning:[/yellow] binding {host} exposes the ride controls to the network"
+        )
+    app = create_app(backend=backend, step_period_s=step_period)
+    console.print(f"passenger page: http://{host}:{port}/  (Ctrl+C to stop)")
+    uvicorn.run(app, host=host, port=port, log_level="warning")
+
+
+def register(app: typer.Typer) -> None:
+    """Add the command to the CLI."""
+    app.command("serve")(serve)
