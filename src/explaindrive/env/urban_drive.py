@@ -35,7 +35,7 @@ from explaindrive.env.reward import (
 )
 from explaindrive.sim.connection import SumoConnection
 from explaindrive.sim.pedestrians import PedestrianSource
-from explaindrive.sim.route import RouteGeometry, load_route_geometry
+from explaindrive.sim.route import RouteCrossing, RouteGeometry, load_route_geometry
 from explaindrive.sim.scenario.files import (
     BASELINE_EGO_TYPES,
     EGO_ID,
@@ -129,6 +129,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._ep: _Episode | None = None
         self._leader_len: dict[str, float] = {}
         self._tls_link: dict[str, int] = {}  # traffic light -> index of the ego's link
+        self._ego_min_gap_m = 0.0  # SUMO reports leader gaps minus the ego's minGap
         self._last_obs = np.zeros(S.STATE_DIM, dtype=np.float32)
 
     # ------------------------------------------------------------------ public API
@@ -347,7 +348,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             "--save-state.rng",
             "true",
             "--time-to-teleport",
-            "300",
+            "-1",
         ]
 
     def _state_file(self, level: float, seed: int) -> Path:
@@ -395,6 +396,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
                 "(the first road stays blocked); lower the traffic level"
             )
         api.vehicle.setLaneChangeMode(EGO_ID, 0)
+        self._ego_min_gap_m = float(api.vehicle.getMinGap(EGO_ID))
         if model == "agent":
             api.vehicle.setSpeedMode(EGO_ID, 0)  # no car-following, light or right-of-way checks
             api.vehicle.setSpeed(EGO_ID, 0.0)
@@ -434,14 +436,20 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         res = self._conn.api.edge.getSubscriptionResults(edge)
         return tuple(res.get(tc.LAST_STEP_PERSON_ID_LIST, ()))
 
-    def _crossing_occupied(self, crossing_edge: str, walkingareas: tuple[str, ...]) -> bool:
-        """A pedestrian is on the crossing or about to step onto it."""
-        if self._persons(crossing_edge):
+    def _crossing_occupied(self, crossing: RouteCrossing) -> bool:
+        """A pedestrian is on the crossing or, at a zebra, about to step onto it.
+
+        At a signalized crossing pedestrians waiting on the kerb wait for their own
+        green, so only those already on the crossing count.
+        """
+        if self._persons(crossing.crossing_edge):
             return True
+        if crossing.signalized:
+            return False
         person = self._conn.api.person
         return any(
-            person.getNextEdge(pid) == crossing_edge
-            for wa in walkingareas
+            person.getNextEdge(pid) == crossing.crossing_edge
+            for wa in crossing.walkingareas
             for pid in self._persons(wa)
         )
 
@@ -456,14 +464,13 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
 
         real: _Leader | None = None
         lead = ego.get(tc.VAR_LEADER)
-        if lead and lead[0] and 0 <= lead[1] < rng:  # lead = (id, gap)
+        gap = float(lead[1]) + self._ego_min_gap_m if lead and lead[0] else rng  # bumper gap
+        if gap < rng:
             lid = lead[0]
             length = self._leader_len.get(lid)
             if length is None:
                 length = self._leader_len[lid] = float(api.vehicle.getLength(lid))
-            real = _Leader(
-                max(float(lead[1]), 0.0), float(api.vehicle.getSpeed(lid)), length, False
-            )
+            real = _Leader(max(gap, 0.0), float(api.vehicle.getSpeed(lid)), length, False)
         leader = real
 
         d_tl, tls = rng, S.LightState.GREEN
@@ -488,7 +495,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         for crossing in self.geometry.crossings:
             ahead = crossing.stop_line_m - pos
             if -EGO_LENGTH_M - 5.0 <= ahead < rng:
-                busy = self._crossing_occupied(crossing.crossing_edge, crossing.walkingareas)
+                busy = self._crossing_occupied(crossing)
                 ep.occupied[crossing.crossing_edge] = bool(self._persons(crossing.crossing_edge))
                 if busy and ahead >= 0.0 and ahead < d_cross:
                     d_cross = ahead

@@ -118,6 +118,8 @@ def netconvert_args(files: dict[str, Path], net_file: Path) -> list[str]:
         str(layout.TLS_CYCLE_S),
         "--tls.yellow.time",
         str(layout.TLS_YELLOW_S),
+        "--tls.allred.time",
+        str(layout.TLS_ALL_RED_S),
         "--tls.left-green.time",
         "0",
         "--walkingareas",

@@ -153,10 +153,12 @@ PEDESTRIAN_FLOWS: tuple[PedestrianFlow, ...] = (
 # it carries its demand up to about traffic level 1.5.
 TLS_CYCLE_S = 60
 TLS_YELLOW_S = 3
+TLS_ALL_RED_S = 2  # [s] clearance between conflicting streams
 TLS_OFFSET_J2_S = 25  # [s] offset of J2 against J1 (a partial green wave)
 TLS_PHASE_DURATIONS_S: dict[str, tuple[int, ...]] = {
-    "J1": (39, 3, 15, 3),  # main green, yellow, side green, yellow
-    "J2": (36, 3, 15, 3, 3),  # main green, yellow, side + pedestrians, side only, yellow
+    "J1": (37, 3, 2, 13, 3, 2),  # main green, yellow, all red, side green, yellow, all red
+    # main green, yellow, all red, side + pedestrians, side only, yellow, all red
+    "J2": (34, 3, 2, 13, 3, 3, 2),
 }
 
 
