@@ -30,7 +30,7 @@ def load_config(path: Path | None) -> LanguageConfig:
 
 def fail(message: str, code: int = 2) -> NoReturn:
     """Print an error on stderr and exit."""
-    err_console.print(f"[bold red]error:[/] {message}", highlight=False)
+    err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
     raise typer.Exit(code)
 
 

@@ -1,0 +1,111 @@
+"""Session fixtures: models are loaded once; a scripted OpenAI-compatible server."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import threading
+import time
+from collections.abc import Iterator
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
+from explaindrive.language.speech import Transcriber
+
+
+@pytest.fixture(scope="session")
+def interpreter() -> EmbeddedIntentInterpreter:
+    """The embedded LLM-1 with its encoder loaded once for the whole session."""
+    it = EmbeddedIntentInterpreter()
+    it.load()
+    return it
+
+
+@pytest.fixture(scope="session")
+def transcriber() -> Transcriber:
+    """Whisper tiny.en, loaded once."""
+    t = Transcriber()
+    t.load()
+    return t
+
+
+@pytest.fixture(scope="session")
+def speak(tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
+    """Synthesise a WAV file with espeak-ng (skips if espeak-ng is not installed)."""
+    exe = shutil.which("espeak-ng")
+    if exe is None:
+        pytest.skip("espeak-ng is not installed (apt-get install espeak-ng)")
+    root = tmp_path_factory.mktemp("speech")
+
+    def _speak(text: str, name: str) -> Path:
+        out = root / f"{name}.wav"
+        subprocess.run([exe, "-s", "150", "-w", str(out), text], check=True)
+        return out
+
+    return _speak
+
+
+class ScriptedOpenAI:
+    """A tiny OpenAI-compatible chat endpoint on 127.0.0.1 that replays scripted answers.
+
+    Each entry of ``script`` is ``("ok", text)``, ``("slow", seconds, text)`` or
+    ``("http", status)``; the last entry repeats. ``requests`` records every request body.
+    """
+
+    def __init__(self) -> None:
+        self.script: list[tuple[Any, ...]] = [("ok", "[EXPLAIN]")]
+        self.requests: list[dict[str, Any]] = []
+        outer = self
+
+        class Handler(BaseHTTPRequestHandler):
+            def log_message(self, *args: Any) -> None:
+                pass
+
+            def do_POST(self) -> None:  # noqa: N802 - http.server API
+                length = int(self.headers.get("Content-Length", "0"))
+                outer.requests.append(json.loads(self.rfile.read(length) or b"{}"))
+                step = outer.script.pop(0) if len(outer.script) > 1 else outer.script[0]
+                if step[0] == "http":
+                    body = json.dumps({"error": {"message": "scripted failure"}}).encode()
+                    self.send_response(step[1])
+                else:
+                    if step[0] == "slow":
+                        time.sleep(step[1])
+                    text = step[-1]
+                    body = json.dumps({
+                        "id": "chatcmpl-test", "object": "chat.completion", "created": 0,
+                        "model": "scripted", "choices": [{
+                            "index": 0, "finish_reason": "stop",
+                            "message": {"role": "assistant", "content": text},
+                        }],
+                    }).encode()
+                    self.send_response(200)
+                self.send_header("Content-Type", "application/json")
+                self.send_header("Content-Length", str(len(body)))
+                self.end_headers()
+                try:
+                    self.wfile.write(body)
+                except BrokenPipeError:  # the client timed out first
+                    pass
+
+        self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.base_url = f"http://127.0.0.1:{self.server.server_address[1]}/v1"
+        self.thread = threading.Thread(target=self.server.serve_forever, daemon=True)
+        self.thread.start()
+
+    def close(self) -> None:
+        self.server.shutdown()
+        self.server.server_close()
+
+
+@pytest.fixture()
+def openai_server() -> Iterator[ScriptedOpenAI]:
+    """A scripted OpenAI-compatible HTTP server started by the test on 127.0.0.1."""
+    srv = ScriptedOpenAI()
+    yield srv
+    srv.close()

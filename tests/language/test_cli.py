@@ -1,0 +1,67 @@
+"""The language CLI commands, called through Typer's test runner."""
+
+from __future__ import annotations
+
+import json
+
+import typer
+from typer.testing import CliRunner
+
+from explaindrive.cli import eval_cmd, eval_language, explain, interpret, transcribe
+
+app = typer.Typer()
+for mod in (interpret, explain, transcribe, eval_cmd, eval_language):
+    mod.register(app)
+runner = CliRunner()
+
+
+def test_explain_json(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    case = tmp_path / "case.json"
+    case.write_text(json.dumps({"request": "comfort", "action": -3, "state": {
+        "v_ego": 9.0, "v_lim": 13.9, "d_lead": None, "dv": None, "d_tl": None,
+        "tl_state": None, "d_cross": 14.0}}))
+    res = runner.invoke(app, ["explain", "--case", str(case), "--json"])
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.stdout)
+    assert out["explain"] is True and out["factor"] == "pedestrian" and "14 m" in out["text"]
+    case.write_text("{oops")
+    res = runner.invoke(app, ["explain", "--case", str(case)])
+    assert res.exit_code == 2 and "not valid JSON" in res.output
+
+
+def test_interpret_json_and_bad_backend(interpreter) -> None:  # type: ignore[no-untyped-def]
+    res = runner.invoke(app, ["interpret", "Stop the car!", "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout) == {
+        "intent": "stop", "confirmation": "You want me to stop, is this correct?",
+        "backend": "embedded", "fallback": False}
+    res = runner.invoke(app, ["interpret", "hi", "--backend", "gpt9"])
+    assert res.exit_code == 2 and "unknown language backend" in res.output
+
+
+def test_transcribe_and_interpret_audio(transcriber, speak, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    wav = speak("Please drive faster, I am late.", "fast")
+    res = runner.invoke(app, ["transcribe", str(wav), "--json"])
+    assert res.exit_code == 0, res.output
+    assert "faster" in json.loads(res.stdout)["text"].lower()
+    res = runner.invoke(app, ["interpret", "--audio", str(tmp_path / "missing.wav")])
+    assert res.exit_code == 2 and "not found" in res.output
+
+
+def test_eval_decisions_writes_report(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    out = tmp_path / "dec.json"
+    res = runner.invoke(app, ["eval", "decisions", "--json", str(out)])
+    assert res.exit_code == 0, res.output
+    report = json.loads(out.read_text())
+    assert report["n"] >= 80 and report["accuracy"] == 1.0 and report["factor_accuracy"] == 1.0
+
+
+def test_eval_intents_small_file(tmp_path, interpreter) -> None:  # type: ignore[no-untyped-def]
+    data = tmp_path / "c.csv"
+    data.write_text("text,label\nPull over now,stop\nPlease speed up,fast\nPlay music,none\n")
+    out = tmp_path / "r.json"
+    res = runner.invoke(app, ["eval", "intents", "--data", str(data), "--json", str(out)])
+    assert res.exit_code == 0, res.output
+    r = json.loads(out.read_text())
+    assert r["n_commands"] == 2 and r["template_compliance"] == 1.0
+    assert r["per_class"]["stop"]["recall"] == 1.0

@@ -1,0 +1,86 @@
+"""Shipped datasets, their loaders, and the metric definitions (hand-computed)."""
+
+from __future__ import annotations
+
+from collections import Counter
+
+import pytest
+
+from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
+from explaindrive.language.config import LanguageConfig
+from explaindrive.language.datasets import (
+    DECISIONS_JSONL,
+    TEST_CSV,
+    TRAIN_CSV,
+    data_path,
+    load_commands,
+    load_decisions,
+)
+from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
+
+
+def test_corpus_sizes_and_held_out_split() -> None:
+    train, test = load_commands(data_path(TRAIN_CSV)), load_commands(data_path(TEST_CSV))
+    assert len(train) + len(test) >= 400 and len(test) >= 120
+    assert {r.text.lower() for r in train}.isdisjoint({r.text.lower() for r in test})
+    counts = Counter(r.label for r in test)
+    assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
+    assert {"direct", "indirect", "negation", "noise"} <= {r.kind for r in test}
+
+
+def test_decision_set() -> None:
+    rows = load_decisions(data_path(DECISIONS_JSONL))
+    assert len(rows) >= 80
+    assert 30 <= sum(r.explain for r in rows) <= 60
+
+
+def test_bad_files(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    p = tmp_path / "c.csv"
+    p.write_text("text,label\nhello,faster\n")
+    with pytest.raises(ValueError, match=r"c.csv:2: unknown label 'faster'"):
+        load_commands(p)
+    p.write_text("words\nhello\n")
+    with pytest.raises(ValueError, match="columns text,label"):
+        load_commands(p)
+    j = tmp_path / "d.jsonl"
+    j.write_text('{"request": "fast"\n')
+    with pytest.raises(ValueError, match=r"d.jsonl:1: not valid JSON"):
+        load_decisions(j)
+    with pytest.raises(FileNotFoundError):
+        load_commands(tmp_path / "none.csv")
+
+
+def test_intent_metrics_by_hand() -> None:
+    truth = ["fast", "fast", "comfort", "comfort", "stop", "stop", "none", "none"]
+    pred = ["fast", "comfort", "comfort", "comfort", "stop", "none", "none", "fast"]
+    conf = ["You want me to drive faster, is this correct?"] * 5 + ["x", None, None]
+    m = intent_metrics(truth, pred, conf)
+    assert m["accuracy"] == pytest.approx(4 / 6, abs=1e-4)
+    # fast P=1 R=.5 F=2/3; comfort P=2/3 R=1 F=.8; stop P=1 R=.5 F=2/3
+    assert m["macro_f1"] == pytest.approx((2 / 3 + 0.8 + 2 / 3) / 3, abs=1e-4)
+    assert m["per_class"]["stop"] == {"precision": 1.0, "recall": 0.5, "f1": 0.6667,
+                                      "support": 2}
+    # po = 4/6; pe = (2*1 + 2*3 + 2*1)/36 (the "none" prediction is its own column)
+    po, pe = 4 / 6, (2 * 1 + 2 * 3 + 2 * 1) / 36
+    assert m["cohen_kappa"] == pytest.approx((po - pe) / (1 - pe), abs=1e-4)
+    assert m["template_compliance"] == pytest.approx(5 / 6, abs=1e-4)
+    assert m["none_rejection"] == 0.5
+    assert m["confusion"]["matrix"][2] == [0, 0, 1, 1]
+
+
+def test_decisions_on_shipped_set_meet_targets() -> None:
+    cfg = LanguageConfig().embedded
+    report = evaluate_decisions(RuleDecider(cfg), TemplateExplainer(cfg),
+                                load_decisions(data_path(DECISIONS_JSONL)))
+    assert report["accuracy"] >= 0.95 and report["factor_accuracy"] >= 0.95
+    assert report["grounded_share"] == 1.0
+    assert all(t["absent_factors"] == [] for t in report["explanations"])
+
+
+def test_config_rejects_unknown_keys(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    p = tmp_path / "lang.yaml"
+    p.write_text("backend: embedded\nopenai:\n  timeout_s: 0.5\n  modle: x\n")
+    with pytest.raises(ValueError, match="modle"):
+        LanguageConfig.from_yaml(p)
+    p.write_text("openai:\n  timeout_s: 0.5\n")
+    assert LanguageConfig.from_yaml(p).openai.timeout_s == 0.5
