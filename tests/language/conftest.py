@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import shutil
 import subprocess
@@ -66,7 +67,7 @@ class ScriptedOpenAI:
             def log_message(self, *args: Any) -> None:
                 pass
 
-            def do_POST(self) -> None:  # noqa: N802 - http.server API
+            def do_POST(self) -> None:
                 length = int(self.headers.get("Content-Length", "0"))
                 outer.requests.append(json.loads(self.rfile.read(length) or b"{}"))
                 step = outer.script.pop(0) if len(outer.script) > 1 else outer.script[0]
@@ -77,21 +78,27 @@ class ScriptedOpenAI:
                     if step[0] == "slow":
                         time.sleep(step[1])
                     text = step[-1]
-                    body = json.dumps({
-                        "id": "chatcmpl-test", "object": "chat.completion", "created": 0,
-                        "model": "scripted", "choices": [{
-                            "index": 0, "finish_reason": "stop",
-                            "message": {"role": "assistant", "content": text},
-                        }],
-                    }).encode()
+                    body = json.dumps(
+                        {
+                            "id": "chatcmpl-test",
+                            "object": "chat.completion",
+                            "created": 0,
+                            "model": "scripted",
+                            "choices": [
+                                {
+                                    "index": 0,
+                                    "finish_reason": "stop",
+                                    "message": {"role": "assistant", "content": text},
+                                }
+                            ],
+                        }
+                    ).encode()
                     self.send_response(200)
                 self.send_header("Content-Type", "application/json")
                 self.send_header("Content-Length", str(len(body)))
                 self.end_headers()
-                try:
+                with contextlib.suppress(BrokenPipeError):  # the client timed out first
                     self.wfile.write(body)
-                except BrokenPipeError:  # the client timed out first
-                    pass
 
         self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
         self.base_url = f"http://127.0.0.1:{self.server.server_address[1]}/v1"

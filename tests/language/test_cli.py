@@ -17,9 +17,23 @@ runner = CliRunner()
 
 def test_explain_json(tmp_path) -> None:  # type: ignore[no-untyped-def]
     case = tmp_path / "case.json"
-    case.write_text(json.dumps({"request": "comfort", "action": -3, "state": {
-        "v_ego": 9.0, "v_lim": 13.9, "d_lead": None, "dv": None, "d_tl": None,
-        "tl_state": None, "d_cross": 14.0}}))
+    case.write_text(
+        json.dumps(
+            {
+                "request": "comfort",
+                "action": -3,
+                "state": {
+                    "v_ego": 9.0,
+                    "v_lim": 13.9,
+                    "d_lead": None,
+                    "dv": None,
+                    "d_tl": None,
+                    "tl_state": None,
+                    "d_cross": 14.0,
+                },
+            }
+        )
+    )
     res = runner.invoke(app, ["explain", "--case", str(case), "--json"])
     assert res.exit_code == 0, res.output
     out = json.loads(res.stdout)
@@ -33,8 +47,11 @@ def test_interpret_json_and_bad_backend(interpreter) -> None:  # type: ignore[no
     res = runner.invoke(app, ["interpret", "Stop the car!", "--json"])
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout) == {
-        "intent": "stop", "confirmation": "You want me to stop, is this correct?",
-        "backend": "embedded", "fallback": False}
+        "intent": "stop",
+        "confirmation": "You want me to stop, is this correct?",
+        "backend": "embedded",
+        "fallback": False,
+    }
     res = runner.invoke(app, ["interpret", "hi", "--backend", "gpt9"])
     assert res.exit_code == 2 and "unknown language backend" in res.output
 

@@ -58,8 +58,7 @@ def test_intent_metrics_by_hand() -> None:
     assert m["accuracy"] == pytest.approx(4 / 6, abs=1e-4)
     # fast P=1 R=.5 F=2/3; comfort P=2/3 R=1 F=.8; stop P=1 R=.5 F=2/3
     assert m["macro_f1"] == pytest.approx((2 / 3 + 0.8 + 2 / 3) / 3, abs=1e-4)
-    assert m["per_class"]["stop"] == {"precision": 1.0, "recall": 0.5, "f1": 0.6667,
-                                      "support": 2}
+    assert m["per_class"]["stop"] == {"precision": 1.0, "recall": 0.5, "f1": 0.6667, "support": 2}
     # po = 4/6; pe = (2*1 + 2*3 + 2*1)/36 (the "none" prediction is its own column)
     po, pe = 4 / 6, (2 * 1 + 2 * 3 + 2 * 1) / 36
     assert m["cohen_kappa"] == pytest.approx((po - pe) / (1 - pe), abs=1e-4)
@@ -70,8 +69,9 @@ def test_intent_metrics_by_hand() -> None:
 
 def test_decisions_on_shipped_set_meet_targets() -> None:
     cfg = LanguageConfig().embedded
-    report = evaluate_decisions(RuleDecider(cfg), TemplateExplainer(cfg),
-                                load_decisions(data_path(DECISIONS_JSONL)))
+    report = evaluate_decisions(
+        RuleDecider(cfg), TemplateExplainer(cfg), load_decisions(data_path(DECISIONS_JSONL))
+    )
     assert report["accuracy"] >= 0.95 and report["factor_accuracy"] >= 0.95
     assert report["grounded_share"] == 1.0
     assert all(t["absent_factors"] == [] for t in report["explanations"])

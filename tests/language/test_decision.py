@@ -33,11 +33,15 @@ def test_priority_pedestrian_then_imminent_leader_then_light() -> None:
     both = rec("fast", -3, d_tl=35.0, tl_state="red", d_cross=20.0, d_lead=8.0, dv=5.0)
     assert rule_decision(both).factor is Factor.PEDESTRIAN
     # leader at 8 m closing at 5 m/s: TTC 1.6 s < 3 s outranks the red light
-    assert rule_decision(rec("fast", -2, d_tl=35.0, tl_state="red", d_lead=8.0, dv=5.0)).factor \
+    assert (
+        rule_decision(rec("fast", -2, d_tl=35.0, tl_state="red", d_lead=8.0, dv=5.0)).factor
         is Factor.LEAD_VEHICLE
+    )
     # leader at 18 m closing at 1 m/s: headway 1.8 s (< 2 s) but TTC 18 s, light first
-    assert rule_decision(rec("fast", -1, d_tl=40.0, tl_state="red", d_lead=18.0, dv=1.0)).factor \
+    assert (
+        rule_decision(rec("fast", -1, d_tl=40.0, tl_state="red", d_lead=18.0, dv=1.0)).factor
         is Factor.TRAFFIC_LIGHT
+    )
 
 
 def test_ordinary_and_supportive_actions_need_no_explanation() -> None:

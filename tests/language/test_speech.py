@@ -23,8 +23,13 @@ def test_transcribes_synthesised_speech(transcriber, speak, interpreter) -> None
 
 @pytest.mark.parametrize(
     ("kind", "message"),
-    [("missing", "not found"), ("empty", "empty"), ("silent", "silent"),
-     ("corrupt", "cannot decode"), ("text", "unsupported audio type")],
+    [
+        ("missing", "not found"),
+        ("empty", "empty"),
+        ("silent", "silent"),
+        ("corrupt", "cannot decode"),
+        ("text", "unsupported audio type"),
+    ],
 )
 def test_bad_audio(transcriber, tmp_path, kind: str, message: str) -> None:  # type: ignore[no-untyped-def]
     path = tmp_path / ("x.txt" if kind == "text" else "x.wav")

@@ -8,8 +8,9 @@ import pytest
 from explaindrive.language.summary import StateRecord, describe_action, environment_summary
 
 
-def _obs(cmd: int, v: float, lim: float, lead: float, dv: float, tl: float, tls: int,
-         cross: float) -> np.ndarray:
+def _obs(
+    cmd: int, v: float, lim: float, lead: float, dv: float, tl: float, tls: int, cross: float
+) -> np.ndarray:
     return np.array([cmd, v, lim, lead, dv, tl, tls, cross], dtype=np.float32)
 
 
@@ -59,8 +60,9 @@ def test_json_errors_are_clear(tmp_path) -> None:  # type: ignore[no-untyped-def
     bad.write_text('{"request": "fast", "action": 9, "state": {"v_ego": 1, "v_lim": 10}}')
     with pytest.raises(ValueError, match="action"):
         StateRecord.load(bad)
-    bad.write_text('{"request": "fast", "action": 0, "speed": 3, '
-                   '"state": {"v_ego": 1, "v_lim": 10}}')
+    bad.write_text(
+        '{"request": "fast", "action": 0, "speed": 3, "state": {"v_ego": 1, "v_lim": 10}}'
+    )
     with pytest.raises(ValueError, match="speed"):
         StateRecord.load(bad)
     with pytest.raises(FileNotFoundError):

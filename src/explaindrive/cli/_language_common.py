@@ -36,4 +36,4 @@ def fail(message: str, code: int = 2) -> NoReturn:
 
 def emit_json(data: Any) -> None:
     """Print JSON on stdout, unstyled so scripts can parse it."""
-    print(json.dumps(data, indent=2, ensure_ascii=False))  # noqa: T201 - the CLI's own output
+    print(json.dumps(data, indent=2, ensure_ascii=False))

@@ -27,6 +27,9 @@ from explaindrive.language.datasets import (
 from explaindrive.language.evaluation import evaluate_decisions, evaluate_intents
 from explaindrive.language.stack import make_language_stack
 
+DEFAULT_COMMANDS = data_path(TEST_CSV)
+DEFAULT_DECISIONS = data_path(DECISIONS_JSONL)
+
 
 def _write(out: Path | None, data: dict[str, Any]) -> None:
     if out is not None:
@@ -36,9 +39,7 @@ def _write(out: Path | None, data: dict[str, Any]) -> None:
 
 
 def intents_command(
-    data: Annotated[Path, typer.Option("--data", help="CSV text,label[,kind].")] = data_path(
-        TEST_CSV
-    ),
+    data: Annotated[Path, typer.Option("--data", help="CSV text,label[,kind].")] = DEFAULT_COMMANDS,
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
@@ -55,8 +56,9 @@ def intents_command(
     for col in ("class", "precision", "recall", "F1", "support"):
         table.add_column(col, justify="right")
     for name, m in report["per_class"].items():
-        table.add_row(name, f"{m['precision']:.3f}", f"{m['recall']:.3f}", f"{m['f1']:.3f}",
-                      str(m["support"]))
+        table.add_row(
+            name, f"{m['precision']:.3f}", f"{m['recall']:.3f}", f"{m['f1']:.3f}", str(m["support"])
+        )
     console.print(table)
     console.print(
         f"accuracy {report['accuracy']:.3f}  macro-F1 {report['macro_f1']:.3f}  "
@@ -68,9 +70,9 @@ def intents_command(
 
 
 def decisions_command(
-    data: Annotated[Path, typer.Option("--data", help="JSONL of labelled records.")] = data_path(
-        DECISIONS_JSONL
-    ),
+    data: Annotated[
+        Path, typer.Option("--data", help="JSONL of labelled records.")
+    ] = DEFAULT_DECISIONS,
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,

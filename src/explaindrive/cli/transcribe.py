@@ -26,8 +26,10 @@ def transcribe_command(
         emit_json(t.to_json())
     else:
         console.print(t.text, highlight=False)
-        console.print(f"[dim]{t.duration_s:.2f} s of audio in {t.processing_s:.2f} s "
-                      f"(real-time factor {t.real_time_factor:.2f})[/]")
+        console.print(
+            f"[dim]{t.duration_s:.2f} s of audio in {t.processing_s:.2f} s "
+            f"(real-time factor {t.real_time_factor:.2f})[/]"
+        )
 
 
 def register(app: typer.Typer) -> None:

@@ -175,20 +175,29 @@ def rule_decision(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> De
     """The grounded rule engine: the embedded LLM-2 (latency and backend filled by callers)."""
     conflict = detect_conflict(record, cutoff_m)
     if conflict is Conflict.NONE:
-        return Decision(False, None, conflict, "action is ordinary or supports the request",
-                        backend="embedded")
+        return Decision(
+            False, None, conflict, "action is ordinary or supports the request", backend="embedded"
+        )
     s = record.nearby(cutoff_m)
     factors = (
         acceleration_factors(s) if conflict is Conflict.HARSH_ACCELERATION else braking_factors(s)
     )
     if not factors:
-        return Decision(False, None, conflict,
-                        f"{conflict.value} but no safety reason within {cutoff_m:g} m",
-                        backend="embedded")
+        return Decision(
+            False,
+            None,
+            conflict,
+            f"{conflict.value} but no safety reason within {cutoff_m:g} m",
+            backend="embedded",
+        )
     names = ", ".join(f.value for f in factors)
-    return Decision(True, factors[0], conflict,
-                    f"{conflict.value} for {factors[0].value} (candidates: {names})",
-                    backend="embedded")
+    return Decision(
+        True,
+        factors[0],
+        conflict,
+        f"{conflict.value} for {factors[0].value} (candidates: {names})",
+        backend="embedded",
+    )
 
 
 def most_critical_factor(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> Factor | None:

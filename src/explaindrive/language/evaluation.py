@@ -26,11 +26,15 @@ def _percentiles(values: list[float]) -> dict[str, float]:
     if not values:
         return {"p50_ms": 0.0, "p95_ms": 0.0}
     arr = np.asarray(values) * 1000.0
-    return {"p50_ms": round(float(np.percentile(arr, 50)), 3),
-            "p95_ms": round(float(np.percentile(arr, 95)), 3)}
+    return {
+        "p50_ms": round(float(np.percentile(arr, 50)), 3),
+        "p95_ms": round(float(np.percentile(arr, 95)), 3),
+    }
 
 
-def intent_metrics(truth: list[str], pred: list[str], confirmations: list[str | None]) -> dict[str, Any]:
+def intent_metrics(
+    truth: list[str], pred: list[str], confirmations: list[str | None]
+) -> dict[str, Any]:
     """Metrics of LLM-1 from labels (``fast|comfort|stop|none``) and predictions.
 
     The 3-class figures (accuracy, macro-F1, kappa, per class) use the rows whose true
@@ -42,23 +46,28 @@ def intent_metrics(truth: list[str], pred: list[str], confirmations: list[str | 
     t3 = [truth[i] for i in idx]
     p3 = [pred[i] for i in idx]
     labels = list(COMMAND_LABELS)
-    prec, rec, f1, sup = precision_recall_fscore_support(
-        t3, p3, labels=labels, zero_division=0
-    )
+    prec, rec, f1, sup = precision_recall_fscore_support(t3, p3, labels=labels, zero_division=0)
     none_idx = [i for i, t in enumerate(truth) if t == "none"]
     return {
         "n": len(truth),
         "n_commands": len(idx),
         "accuracy": round(float(accuracy_score(t3, p3)), 4),
-        "macro_f1": round(float(f1_score(t3, p3, labels=labels, average="macro",
-                                         zero_division=0)), 4),
+        "macro_f1": round(
+            float(f1_score(t3, p3, labels=labels, average="macro", zero_division=0)), 4
+        ),
         "cohen_kappa": round(float(cohen_kappa_score(t3, p3)), 4),
         "template_compliance": round(
             float(np.mean([is_template_compliant(confirmations[i]) for i in idx])), 4
-        ) if idx else 0.0,
+        )
+        if idx
+        else 0.0,
         "per_class": {
-            name: {"precision": round(float(prec[k]), 4), "recall": round(float(rec[k]), 4),
-                   "f1": round(float(f1[k]), 4), "support": int(sup[k])}
+            name: {
+                "precision": round(float(prec[k]), 4),
+                "recall": round(float(rec[k]), 4),
+                "f1": round(float(f1[k]), 4),
+                "support": int(sup[k]),
+            }
             for k, name in enumerate(labels)
         },
         "confusion": {
@@ -66,7 +75,8 @@ def intent_metrics(truth: list[str], pred: list[str], confirmations: list[str | 
             "matrix": confusion_matrix(truth, pred, labels=list(CONFUSION_LABELS)).tolist(),
         },
         "none_rejection": round(float(np.mean([pred[i] == "none" for i in none_idx])), 4)
-        if none_idx else None,
+        if none_idx
+        else None,
         "n_none": len(none_idx),
     }
 
@@ -119,10 +129,17 @@ def evaluate_decisions(
             e = explainer.explain(rec, d.factor)
             lat_explain.append(e.latency_s)
             g = check_grounding(e.text, row.factor, rec)
-            texts.append({"id": row.id, "factor": d.factor.value if d.factor else None,
-                          "label_factor": row.factor.value if row.factor else None,
-                          "text": e.text, "names_factor": g.names_factor,
-                          "absent_factors": [f.value for f in g.absent], "grounded": g.ok})
+            texts.append(
+                {
+                    "id": row.id,
+                    "factor": d.factor.value if d.factor else None,
+                    "label_factor": row.factor.value if row.factor else None,
+                    "text": e.text,
+                    "names_factor": g.names_factor,
+                    "absent_factors": [f.value for f in g.absent],
+                    "grounded": g.ok,
+                }
+            )
             if row.explain:
                 factor_hits.append(d.factor == row.factor)
     prec, rec_, f1, _ = precision_recall_fscore_support(
@@ -138,7 +155,8 @@ def evaluate_decisions(
         "f1": round(float(f1), 4),
         "factor_accuracy": round(float(np.mean(factor_hits)), 4) if factor_hits else None,
         "grounded_share": round(float(np.mean([t["grounded"] for t in labelled])), 4)
-        if labelled else None,
+        if labelled
+        else None,
         "fallbacks": fallbacks,
         "latency": {"decide": _percentiles(lat_decide), "explain": _percentiles(lat_explain)},
         "explanations": texts,

@@ -105,12 +105,21 @@ _OPENERS: dict[str, tuple[str, ...]] = {
         "Apologies for braking a bit sharply",
         "Sorry about that quick stop",
     ),
-    "hold": ("I'm holding our speed for now", "I'm not speeding up just yet",
-             "I'm keeping us steady for a moment"),
-    "wait": ("We're waiting here for a moment", "I'm keeping us stopped for now",
-             "We're staying put for a moment"),
-    "accelerate": ("Sorry for the quick acceleration", "Apologies for the sudden burst of speed",
-                   "Sorry for speeding up so briskly"),
+    "hold": (
+        "I'm holding our speed for now",
+        "I'm not speeding up just yet",
+        "I'm keeping us steady for a moment",
+    ),
+    "wait": (
+        "We're waiting here for a moment",
+        "I'm keeping us stopped for now",
+        "We're staying put for a moment",
+    ),
+    "accelerate": (
+        "Sorry for the quick acceleration",
+        "Apologies for the sudden burst of speed",
+        "Sorry for speeding up so briskly",
+    ),
 }
 
 _REASONS: dict[Factor, tuple[str, ...]] = {

@@ -95,17 +95,56 @@ def is_template_compliant(text: str | None) -> bool:
 
 
 _YES_PHRASES = (
-    "no problem", "no worries", "why not", "of course", "that's right", "thats right",
-    "that is right", "go ahead", "do it", "sounds good", "please do", "you got it",
+    "no problem",
+    "no worries",
+    "why not",
+    "of course",
+    "that's right",
+    "thats right",
+    "that is right",
+    "go ahead",
+    "do it",
+    "sounds good",
+    "please do",
+    "you got it",
 )
 _NO_PHRASES = (
-    "not correct", "not right", "isn't right", "isnt right", "that's wrong", "thats wrong",
-    "don't", "dont", "do not", "never mind", "nevermind", "not what i",
+    "not correct",
+    "not right",
+    "isn't right",
+    "isnt right",
+    "that's wrong",
+    "thats wrong",
+    "don't",
+    "dont",
+    "do not",
+    "never mind",
+    "nevermind",
+    "not what i",
 )
-_YES_WORDS = frozenset({
-    "yes", "yeah", "yep", "yup", "ya", "correct", "right", "sure", "ok", "okay", "affirmative",
-    "absolutely", "definitely", "indeed", "confirm", "confirmed", "exactly", "perfect", "fine",
-})
+_YES_WORDS = frozenset(
+    {
+        "yes",
+        "yeah",
+        "yep",
+        "yup",
+        "ya",
+        "correct",
+        "right",
+        "sure",
+        "ok",
+        "okay",
+        "affirmative",
+        "absolutely",
+        "definitely",
+        "indeed",
+        "confirm",
+        "confirmed",
+        "exactly",
+        "perfect",
+        "fine",
+    }
+)
 _NO_WORDS = frozenset({"no", "nope", "nah", "not", "wrong", "incorrect", "cancel", "negative"})
 
 

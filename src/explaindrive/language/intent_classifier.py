@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import argparse
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -54,7 +54,7 @@ class IntentClassifier:
     ref_labels: NDArray[np.int64]  # (n_train,) indices into INTENT_LABELS
     stop_threshold: float
     none_threshold: float
-    spec: FeatureSpec = FeatureSpec()
+    spec: FeatureSpec = field(default_factory=FeatureSpec)
 
     def proba(self, x: NDArray[np.floating]) -> NDArray[np.float64]:
         """Class probabilities for feature rows ``x`` (``[embedding | n-grams]``)."""
@@ -66,7 +66,9 @@ class IntentClassifier:
         return LR_WEIGHT * p_lr + (1.0 - LR_WEIGHT) * p_knn
 
     def decide(
-        self, p: NDArray[np.floating], stop_threshold: float | None = None,
+        self,
+        p: NDArray[np.floating],
+        stop_threshold: float | None = None,
         none_threshold: float | None = None,
     ) -> str:
         """Label for one probability row: ``stop`` first, then ``none``, then the argmax."""
@@ -82,10 +84,16 @@ class IntentClassifier:
     def save(self, path: str | Path) -> None:
         """Write the weights as ``.npz``."""
         np.savez_compressed(
-            path, coef=self.coef, intercept=self.intercept, labels=np.array(INTENT_LABELS),
-            ref_embeddings=self.ref_embeddings.astype(np.float16), ref_labels=self.ref_labels,
-            stop_threshold=self.stop_threshold, none_threshold=self.none_threshold,
-            hash_features=self.spec.hash_features, ngram_weight=self.spec.ngram_weight,
+            path,
+            coef=self.coef,
+            intercept=self.intercept,
+            labels=np.array(INTENT_LABELS),
+            ref_embeddings=self.ref_embeddings.astype(np.float16),
+            ref_labels=self.ref_labels,
+            stop_threshold=self.stop_threshold,
+            none_threshold=self.none_threshold,
+            hash_features=self.spec.hash_features,
+            ngram_weight=self.spec.ngram_weight,
         )
 
     @classmethod
@@ -131,8 +139,12 @@ def knn_proba(
     """Softmax over, per class, the best cosine similarity to a training request."""
     sims = np.asarray(emb, dtype=np.float32) @ np.asarray(ref, dtype=np.float32).T
     best = np.stack(
-        [sims[:, ref_labels == k].max(axis=1) if (ref_labels == k).any()
-         else np.full(len(sims), -1.0) for k in range(len(INTENT_LABELS))],
+        [
+            sims[:, ref_labels == k].max(axis=1)
+            if (ref_labels == k).any()
+            else np.full(len(sims), -1.0)
+            for k in range(len(INTENT_LABELS))
+        ],
         axis=1,
     )
     return _softmax(best / KNN_TEMPERATURE)
@@ -155,8 +167,13 @@ def _fit(x: NDArray[np.float32], y: NDArray[np.int64], c: float) -> LogisticRegr
 
 
 def train(
-    texts: list[str], labels: list[str], encoder: SentenceEncoder, *, c: float = DEFAULT_C,
-    folds: int = 5, seed: int = 0,
+    texts: list[str],
+    labels: list[str],
+    encoder: SentenceEncoder,
+    *,
+    c: float = DEFAULT_C,
+    folds: int = 5,
+    seed: int = 0,
 ) -> IntentClassifier:
     """Train on labelled requests and tune the STOP threshold by cross-validation.
 
@@ -177,9 +194,13 @@ def train(
     stop_t = tune_stop_threshold(oof[:, STOP], y == STOP)
     model = _fit(x, y, c)
     clf = IntentClassifier(
-        model.coef_.astype(np.float64), model.intercept_.astype(np.float64),
-        ref_embeddings=x[:, :dim].copy(), ref_labels=y, stop_threshold=stop_t,
-        none_threshold=0.0, spec=spec,
+        model.coef_.astype(np.float64),
+        model.intercept_.astype(np.float64),
+        ref_embeddings=x[:, :dim].copy(),
+        ref_labels=y,
+        stop_threshold=stop_t,
+        none_threshold=0.0,
+        spec=spec,
     )
     cv_pred = [clf.decide(row) for row in oof]
     cv_acc = float(np.mean([p == t for p, t in zip(cv_pred, labels, strict=True)]))

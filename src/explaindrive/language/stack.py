@@ -28,7 +28,9 @@ class LanguageStack:
     transcriber: Transcriber
 
 
-def make_language_stack(backend: str | None = None, config: LanguageConfig | None = None) -> LanguageStack:
+def make_language_stack(
+    backend: str | None = None, config: LanguageConfig | None = None
+) -> LanguageStack:
     """Build interpreter, decider, explainer and transcriber for ``backend``.
 
     Models load lazily (on first use); call ``stack.interpreter.load()`` /

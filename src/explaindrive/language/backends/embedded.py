@@ -46,13 +46,10 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         """Classify ``text``; an empty or off-topic request gets a request to rephrase."""
         t0 = time.perf_counter()
         if not text or not text.strip():
-            return IntentResult(None, REPHRASE_MESSAGE, NAME, False,
-                                time.perf_counter() - t0, {})
+            return IntentResult(None, REPHRASE_MESSAGE, NAME, False, time.perf_counter() - t0, {})
         x = features(self.encoder, [text], self.classifier.spec)
         p = self.classifier.proba(x)[0]
-        label = self.classifier.decide(
-            p, self.config.stop_threshold, self.config.none_threshold
-        )
+        label = self.classifier.decide(p, self.config.stop_threshold, self.config.none_threshold)
         scores = {name: round(float(v), 4) for name, v in zip(INTENT_LABELS, p, strict=True)}
         intent = None if label == "none" else Command.parse(label)
         confirmation = format_confirmation(intent) if intent is not None else REPHRASE_MESSAGE
@@ -74,8 +71,9 @@ class RuleDecider(ExplanationDecider):
         """Decide whether to explain ``record``'s action."""
         t0 = time.perf_counter()
         d = rule_decision(record, self.config.cutoff_m)
-        return Decision(d.explain, d.factor, d.conflict, d.reason, NAME,
-                        latency_s=time.perf_counter() - t0)
+        return Decision(
+            d.explain, d.factor, d.conflict, d.reason, NAME, latency_s=time.perf_counter() - t0
+        )
 
 
 class TemplateExplainer(Explainer):

@@ -140,13 +140,21 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             command = parse_confirmation(reply)
             if command is None:
                 raise BackendReplyError(f"reply does not follow the template: {reply[:120]!r}")
-            return IntentResult(command, reply.strip().strip("\"'"), NAME, False,
-                                time.perf_counter() - t0, {})
+            return IntentResult(
+                command, reply.strip().strip("\"'"), NAME, False, time.perf_counter() - t0, {}
+            )
         except Exception as exc:  # any endpoint failure: answer offline instead
             log.warning("openai intent failed, using embedded: %s", _err(exc))
             r = self.fallback.interpret(text)
-            return IntentResult(r.intent, r.confirmation, r.backend, True,
-                                time.perf_counter() - t0, r.scores, _err(exc))
+            return IntentResult(
+                r.intent,
+                r.confirmation,
+                r.backend,
+                True,
+                time.perf_counter() - t0,
+                r.scores,
+                _err(exc),
+            )
 
 
 class OpenAIDecider(ExplanationDecider):
@@ -164,20 +172,36 @@ class OpenAIDecider(ExplanationDecider):
         t0 = time.perf_counter()
         cutoff = self.fallback.config.cutoff_m
         try:
-            reply = self.client.complete(DECISION_PROMPT, situation_message(record, cutoff),
-                                         self.client.config.decision_temperature)
+            reply = self.client.complete(
+                DECISION_PROMPT,
+                situation_message(record, cutoff),
+                self.client.config.decision_temperature,
+            )
             explain = parse_decision_tag(reply)
             if explain is None:
                 raise BackendReplyError(f"reply is not one tag: {reply[:120]!r}")
             factor = most_critical_factor(record, cutoff) if explain else None
-            return Decision(explain, factor, detect_conflict(record, cutoff),
-                            f"endpoint replied {reply.strip()}", NAME,
-                            latency_s=time.perf_counter() - t0)
+            return Decision(
+                explain,
+                factor,
+                detect_conflict(record, cutoff),
+                f"endpoint replied {reply.strip()}",
+                NAME,
+                latency_s=time.perf_counter() - t0,
+            )
         except Exception as exc:
             log.warning("openai decision failed, using rules: %s", _err(exc))
             d = self.fallback.decide(record)
-            return Decision(d.explain, d.factor, d.conflict, d.reason, d.backend, True,
-                            time.perf_counter() - t0, _err(exc))
+            return Decision(
+                d.explain,
+                d.factor,
+                d.conflict,
+                d.reason,
+                d.backend,
+                True,
+                time.perf_counter() - t0,
+                _err(exc),
+            )
 
 
 class OpenAIExplainer(Explainer):
@@ -196,8 +220,11 @@ class OpenAIExplainer(Explainer):
         cutoff = self.fallback.config.cutoff_m
         factor = factor or most_critical_factor(record, cutoff)
         try:
-            reply = self.client.complete(EXPLAIN_PROMPT, situation_message(record, cutoff),
-                                         self.client.config.explain_temperature).strip()
+            reply = self.client.complete(
+                EXPLAIN_PROMPT,
+                situation_message(record, cutoff),
+                self.client.config.explain_temperature,
+            ).strip()
             if not reply or len(reply) > MAX_EXPLANATION_CHARS:
                 raise BackendReplyError(f"explanation empty or too long ({len(reply)} chars)")
             grounding = check_grounding(reply, None, record, cutoff)
@@ -208,5 +235,6 @@ class OpenAIExplainer(Explainer):
         except Exception as exc:
             log.warning("openai explanation failed, using templates: %s", _err(exc))
             e = self.fallback.explain(record, factor)
-            return Explanation(e.text, e.factor, e.backend, True, time.perf_counter() - t0,
-                               _err(exc))
+            return Explanation(
+                e.text, e.factor, e.backend, True, time.perf_counter() - t0, _err(exc)
+            )
