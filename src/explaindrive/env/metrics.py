@@ -9,7 +9,8 @@ latency and travel time. Feed every ``info`` from ``env.step`` to
 Definitions:
     mean speed   mean of the ego speed over all steps [m/s]
     avg TH       mean time headway to the real leader, over steps with a real
-                 leader in range and the ego moving [s]
+                 leader in range and the ego moving at >= 1 m/s (a creeping car
+                 has an unbounded headway that says nothing) [s]
     avg TTC      mean TTC to the real leader over the interaction steps: the ego
                  closes in on it and TTC < TTC_INTERACTION_S (10 s); larger
                  TTCs mean no conflict and would swamp the mean [s]
@@ -25,6 +26,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 TTC_INTERACTION_S = 10.0  # [s] TTCs at or above this are not counted as interactions
+MOVING_SPEED_MPS = 1.0  # [m/s] headways are averaged over steps at or above this speed
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,7 +91,7 @@ class EpisodeMetrics:
         self.speeds.append(speed)
         self.jerks.append(abs(float(info["jerk_mps3"])))
         headway = float(info["real_headway_s"])
-        if math.isfinite(headway):
+        if math.isfinite(headway) and speed >= MOVING_SPEED_MPS:
             self.headways.append(headway)
         ttc = float(info["real_ttc_s"])
         if ttc < TTC_INTERACTION_S:

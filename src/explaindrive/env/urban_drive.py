@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import math
 import os
+import subprocess
 import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -46,6 +47,7 @@ from explaindrive.sim.scenario.files import (
     default_scenario,
 )
 from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES
+from explaindrive.sim.sumo_home import sumo_binary
 
 log = logging.getLogger(__name__)
 
@@ -352,24 +354,43 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ]
 
     def _state_file(self, level: float, seed: int) -> Path:
-        demand = self.scenario.routes_file(level).name.split(".")[0]  # carries the demand hash
-        return self.scenario.state_dir() / f"{demand}_seed{seed}_w{self.config.warmup_s}.xml"
+        demand = self.scenario.routes_file(level).name.removesuffix(".rou.xml")  # level + hash
+        return self.scenario.state_dir() / f"{demand}_seed{seed}_warm{self.config.warmup_s}.xml"
 
     def _restore_warm_state(self, level: float, seed: int) -> None:
         """Continue from the cached warm-up state of (level, seed), creating it if needed."""
-        api = self._conn.api
+        if self.config.warmup_s == 0:
+            return
         path = self._state_file(level, seed)
         if not path.exists():
-            for _ in range(self.config.warmup_s):
-                api.simulationStep()
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".xml")
-            os.close(fd)
-            api.simulation.saveState(tmp)
-            os.replace(tmp, path)
-            # Restart so that a fresh and a cached run go through the same steps.
-            api.load(self._sumo_args(level, seed))
-        api.simulation.loadState(str(path))
+            self._write_warm_state(level, seed, path)
+        self._conn.api.simulation.loadState(str(path))
+
+    def _write_warm_state(self, level: float, seed: int, path: Path) -> None:
+        """Simulate the warm-up in a fresh ``sumo`` process and save its state.
+
+        A separate process keeps the result independent of whatever this process
+        simulated before (libsumo keeps some random state across restarts).
+        """
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".xml")
+        os.close(fd)
+        warmup = str(self.config.warmup_s)
+        args = [
+            sumo_binary("sumo"),
+            *self._sumo_args(level, seed),
+            "--end",
+            str(self.config.warmup_s + 1),
+            "--save-state.times",
+            warmup,
+            "--save-state.files",
+            tmp,
+        ]
+        proc = subprocess.run(args, capture_output=True, text=True, check=False)
+        if proc.returncode != 0:
+            Path(tmp).unlink(missing_ok=True)
+            raise RuntimeError(f"SUMO warm-up failed ({proc.returncode}): {proc.stderr[-2000:]}")
+        os.replace(tmp, path)
 
     def _insert_ego(self) -> float:
         api = self._conn.api

@@ -52,7 +52,8 @@ def routes_xml(traffic_level: float) -> str:
         cf = "Krauss" if model == "krauss" else "IDM"
         lines.append(
             f'    <vType id="{type_id}" length="5" minGap="2.5" maxSpeed="20" accel="3" '
-            f'decel="3" emergencyDecel="9" carFollowModel="{cf}" color="0,0,1"/>'
+            f'decel="3" emergencyDecel="9" speedFactor="1" speedDev="0" '
+            f'carFollowModel="{cf}" color="0,0,1"/>'
         )
     lines.append(
         '    <vType id="background" length="5" minGap="2.5" maxSpeed="20" accel="2.6" '
