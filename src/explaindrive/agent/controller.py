@@ -18,6 +18,7 @@ import torch
 
 from explaindrive.agent.checkpoint import CheckpointError, load_policy
 from explaindrive.agent.network import DuelingQNetwork
+from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
 from explaindrive.env.state import CMD, STATE_DIM
 
@@ -69,21 +70,33 @@ class MergedController:
         fast: the fast-driving policy.
         comfort: the comfort-driving policy.
         command: the initial command (stop starts on the fast agent).
+        use_shield: pass the greedy action through the kinematic safety shield
+            (:mod:`explaindrive.agent.shield`); ``overrides`` counts its interventions.
     """
 
-    def __init__(self, fast: QPolicy, comfort: QPolicy, command: Command | str = Command.FAST):
+    def __init__(
+        self,
+        fast: QPolicy,
+        comfort: QPolicy,
+        command: Command | str = Command.FAST,
+        use_shield: bool = True,
+    ):
         self.policies = {Command.FAST: fast, Command.COMFORT: comfort}
         self.active_agent = Command.FAST
         self.command = Command.FAST
+        self.use_shield = use_shield
+        self.overrides = 0
         self.set_command(command)
 
     @classmethod
-    def from_files(cls, fast_path: str | Path, comfort_path: str | Path) -> MergedController:
+    def from_files(
+        cls, fast_path: str | Path, comfort_path: str | Path, use_shield: bool = True
+    ) -> MergedController:
         """Controller over two policy files."""
-        return cls(QPolicy.load(fast_path), QPolicy.load(comfort_path))
+        return cls(QPolicy.load(fast_path), QPolicy.load(comfort_path), use_shield=use_shield)
 
     @classmethod
-    def from_package(cls) -> MergedController:
+    def from_package(cls, use_shield: bool = True) -> MergedController:
         """Controller over the policies shipped with the package.
 
         Raises:
@@ -96,7 +109,7 @@ class MergedController:
                     f"shipped policy not found: {p}; train one with "
                     f"`explaindrive train --mode {p.stem}` and copy its policy.pt/.json there"
                 )
-        return cls.from_files(*paths)
+        return cls.from_files(*paths, use_shield=use_shield)
 
     def set_command(self, command: Command | str | int) -> None:
         """Apply a passenger command; stop keeps the current agent."""
@@ -121,4 +134,9 @@ class MergedController:
 
     def act(self, obs: np.ndarray) -> int:
         """Action of the active agent for a raw observation under the current command."""
-        return self.policy.act(self.observation(obs))
+        x = self.observation(obs)
+        if not self.use_shield:
+            return self.policy.act(x)
+        decision = shield(x, self.policy.q_values(x))
+        self.overrides += int(decision.overridden)
+        return decision.action

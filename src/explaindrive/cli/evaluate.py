@@ -68,6 +68,10 @@ def evaluate_command(
         Path | None,
         typer.Option("--comfort-policy", help="Comfort policy file instead of the shipped."),
     ] = None,
+    shield: Annotated[
+        bool,
+        typer.Option("--shield/--no-shield", help="Agents act through the safety shield."),
+    ] = True,
     episodes: Annotated[
         bool, typer.Option("--episodes/--no-episodes", help="Also print one row per episode.")
     ] = True,
@@ -88,7 +92,9 @@ def evaluate_command(
     )
 
     try:
-        spec = parse_policy(policy, fast_path=fast_policy, comfort_path=comfort_policy)
+        spec = parse_policy(
+            policy, fast_path=fast_policy, comfort_path=comfort_policy, shield=shield
+        )
         plan = plan_run(
             spec, parse_seeds(seeds), parse_levels(traffic),
             stop_schedule=stop_schedule, commands=commands, max_steps=max_steps,

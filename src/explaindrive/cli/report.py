@@ -38,6 +38,10 @@ def report_command(
         Path | None,
         typer.Option("--comfort-policy", help="Comfort policy file instead of the shipped."),
     ] = None,
+    shield: Annotated[
+        bool,
+        typer.Option("--shield/--no-shield", help="Agents act through the safety shield."),
+    ] = True,
     runs_dir: Annotated[
         Path,
         typer.Option("--runs", help="Training runs (<dir>/fast, <dir>/comfort) for the curves."),
@@ -69,6 +73,7 @@ def report_command(
         plan = plan_report(
             names, tuple(range(episodes_per_cell)), parse_levels(traffic),
             fast_path=fast_policy, comfort_path=comfort_policy, max_steps=max_steps,
+            shield=shield,
         )  # fmt: skip
     except SpecError as exc:
         err_console.print(f"[red]error:[/red] {exc}")

@@ -85,6 +85,7 @@ def plan_report(
     fast_path: str | Path | None = None,
     comfort_path: str | Path | None = None,
     max_steps: int = 1000,
+    shield: bool = True,
 ) -> ReportPlan:
     """Lay out the runs: each agent and baseline alone and with the paper's stop injections,
     and the merged fast -> stop -> comfort single episode.
@@ -95,7 +96,7 @@ def plan_report(
     resolved: dict[str, PolicySpec] = {}
     runs: list[RunPlan] = []
     for name in policies:
-        spec = parse_policy(name, fast_path=fast_path, comfort_path=comfort_path)
+        spec = parse_policy(name, fast_path=fast_path, comfort_path=comfort_path, shield=shield)
         resolved[name] = spec
         if name == MERGED:
             runs.append(

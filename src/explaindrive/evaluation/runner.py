@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from explaindrive.commands import Command
 from explaindrive.env.actions import IDLE_ACTION
 from explaindrive.env.metrics import EpisodeMetrics, EpisodeResult
 from explaindrive.evaluation.spec import EpisodeSpec, PolicySpec
@@ -38,12 +39,14 @@ class EpisodeRecord:
         result: the episode's figures (see :mod:`explaindrive.env.metrics`).
         speeds_mps: ego speed after each step [m/s].
         commands: the command under which each step's action was taken.
+        shield_overrides: steps in which the safety shield replaced the policy's action.
     """
 
     spec: EpisodeSpec
     result: EpisodeResult
     speeds_mps: tuple[float, ...]
     commands: tuple[str, ...]
+    shield_overrides: int = 0
 
 
 @functools.lru_cache(maxsize=8)
@@ -51,15 +54,16 @@ def _load_driver(policy: PolicySpec) -> Any:
     from explaindrive.agent.controller import MergedController, QPolicy
 
     if policy.kind == "merged":
-        return MergedController.from_files(*policy.paths)
-    return QPolicy.load(policy.paths[0])
+        return MergedController.from_files(*policy.paths, use_shield=policy.shield)
+    agent = QPolicy.load(policy.paths[0])
+    # One agent under its own command and stop: the merged controller over it twice.
+    return MergedController(agent, agent, Command.parse(policy.primary), use_shield=policy.shield)
 
 
 def _decide(policy: PolicySpec, driver: Any, env: Any, obs: np.ndarray) -> int:
     if policy.kind == "baseline":
         return IDLE_ACTION  # SUMO drives the ego; the action is ignored
-    if policy.kind == "merged":
-        driver.set_command(env.command)
+    driver.set_command(env.command)
     return int(driver.act(obs))
 
 
@@ -75,6 +79,12 @@ def run_episode(spec: EpisodeSpec) -> EpisodeRecord:
 
     policy = spec.policy
     driver = None if policy.kind == "baseline" else _load_driver(policy)
+    overrides_before = 0
+    if driver is not None:
+        overrides_before = driver.overrides
+        driver.active_agent = (
+            Command.FAST if policy.kind == "merged" else Command.parse(policy.primary)
+        )
     config = EnvConfig(
         traffic_level=spec.traffic_level, max_steps=spec.max_steps, ego_model=policy.ego_model
     )
@@ -103,7 +113,8 @@ def run_episode(spec: EpisodeSpec) -> EpisodeRecord:
         env.close()
     log.debug("episode %s seed=%d level=%g: %d steps", policy.name, spec.seed,
               spec.traffic_level, len(speeds))  # fmt: skip
-    return EpisodeRecord(spec, metrics.result(), tuple(speeds), tuple(commands))
+    overrides = (driver.overrides - overrides_before) if driver is not None else 0
+    return EpisodeRecord(spec, metrics.result(), tuple(speeds), tuple(commands), overrides)
 
 
 def _worker_init() -> None:

@@ -14,6 +14,7 @@ Layout (``version`` 1)::
           "paper": {...PaperRow...} | null,
           "episodes": [
             {"seed": 0, "traffic_level": 0.5, "metrics": {...EpisodeResult...},
+             "shield_overrides": 3,
              "trace": {"speed_mps": [...], "command": [...]}}
           ]
         }
@@ -61,6 +62,7 @@ def episode_document(record: EpisodeRecord, include_trace: bool = True) -> dict[
         "seed": record.spec.seed,
         "traffic_level": record.spec.traffic_level,
         "metrics": record.result.as_dict(),
+        "shield_overrides": record.shield_overrides,
     }
     if include_trace:
         doc["trace"] = {"speed_mps": list(record.speeds_mps), "command": list(record.commands)}

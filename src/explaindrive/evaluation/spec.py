@@ -46,6 +46,7 @@ class PolicySpec:
         paths: policy files: one for an agent, (fast, comfort) for merged, none for baselines.
         ego_model: the env's ``ego_model``: ``"agent"``, ``"krauss"`` or ``"idm"``.
         primary: the command the policy drives under when no schedule says otherwise.
+        shield: agents act through the kinematic safety shield (``agent/shield.py``).
     """
 
     name: str
@@ -53,6 +54,7 @@ class PolicySpec:
     paths: tuple[str, ...]
     ego_model: str
     primary: str
+    shield: bool = True
 
     @property
     def allowed_commands(self) -> tuple[str, ...]:
@@ -64,7 +66,8 @@ class PolicySpec:
     def as_dict(self) -> dict[str, object]:
         """JSON-ready dict."""
         return {"name": self.name, "kind": self.kind, "paths": list(self.paths),
-                "ego_model": self.ego_model, "primary": self.primary}  # fmt: skip
+                "ego_model": self.ego_model, "primary": self.primary,
+                "shield": self.shield if self.kind != "baseline" else None}  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True)
@@ -291,6 +294,7 @@ def parse_policy(
     *,
     fast_path: str | Path | None = None,
     comfort_path: str | Path | None = None,
+    shield: bool = True,
 ) -> PolicySpec:
     """Resolve ``fast | comfort | merged | krauss | idm | PATH`` into a :class:`PolicySpec`.
 
@@ -298,6 +302,7 @@ def parse_policy(
         text: the policy name or a policy file / training run directory.
         fast_path: use this file instead of the shipped fast policy.
         comfort_path: use this file instead of the shipped comfort policy.
+        shield: agents act through the safety shield (ignored for baselines).
 
     Raises:
         SpecError: if a policy file is missing.
@@ -308,15 +313,15 @@ def parse_policy(
         return PolicySpec(key, "baseline", (), key, Command.FAST.label)
     if key in AGENTS:
         path = _shipped(key, fast_path if key == "fast" else comfort_path)
-        return PolicySpec(key, "agent", (str(path),), "agent", key)
+        return PolicySpec(key, "agent", (str(path),), "agent", key, shield)
     if key == MERGED:
         paths = (_shipped("fast", fast_path), _shipped("comfort", comfort_path))
         return PolicySpec(MERGED, "merged", tuple(str(p) for p in paths), "agent",
-                          Command.FAST.label)  # fmt: skip
+                          Command.FAST.label, shield)  # fmt: skip
     path = _policy_file(name)
     stem = path.parent.name if path.stem == "policy" else path.stem
     primary = _card_mode(path) or Command.FAST.label
-    return PolicySpec(stem, "agent", (str(path),), "agent", primary)
+    return PolicySpec(stem, "agent", (str(path),), "agent", primary, shield)
 
 
 # ---------------------------------------------------------------------------- grids

@@ -1,0 +1,98 @@
+"""A kinematic safety shield: keeps a policy's greedy choice unless it is unsafe.
+
+Among the actions ordered by Q-value, the shield takes the first one after
+which the ego could still stop behind its leader (real or virtual) braking at
+-3 m/s per step, even if a real leader brakes at 9 m/s^2 (SUMO's emergency
+deceleration), and which does not
+exceed the posted limit. If no action qualifies, it brakes as hard as it can.
+
+Red and yellow lights and occupied crossings are stop lines the ego must be able
+to stop before; a yellow light the ego can no longer stop for is not (the
+dilemma zone): braking would only leave the car on the junction at red.
+The shield is off during training; it is a runtime guard in the controller.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from explaindrive.env import state as S
+from explaindrive.env.actions import SPEED_CHANGES_MPS, action_index
+
+MAX_BRAKE_MPS = 3  # [m/s per step] the strongest action
+LEADER_BRAKE_MPS = 9.0  # [m/s per step] how hard a real leader may brake (SUMO emergency decel)
+MARGIN_M = 2.0  # [m] gap kept at standstill
+VIRTUAL_TOL_M = 0.5  # [m] a leader this close to a stop line is the virtual leader
+
+
+def braking_distance(speed_mps: float, brake_mps: float = MAX_BRAKE_MPS) -> float:
+    """Distance [m] covered after this step when braking by ``brake_mps`` per 1 s step.
+
+    SUMO moves a car by its new speed each step, so from ``v`` the car covers
+    (v - 3) + (v - 6) + ... while braking to a standstill.
+    """
+    total, v = 0.0, speed_mps - brake_mps
+    while v > 0:
+        total += v
+        v -= brake_mps
+    return total
+
+
+@dataclass(frozen=True, slots=True)
+class ShieldDecision:
+    """The shielded action and whether the shield overrode the policy."""
+
+    action: int
+    overridden: bool
+
+
+def is_safe(obs: NDArray[np.floating], action: int) -> bool:
+    """Whether ``action`` keeps a stopping option and respects the posted limit."""
+    v = float(obs[S.V_EGO])
+    v_new = max(0.0, v + SPEED_CHANGES_MPS[action])
+    if v_new > float(obs[S.V_LIM]) and v_new > v - MAX_BRAKE_MPS + 1e-9:
+        return False
+    need = v_new + braking_distance(v_new) + MARGIN_M  # [m] to a standstill after this step
+    for stop_line in _stop_lines(obs, v):
+        if need > stop_line:
+            return False
+    gap = float(obs[S.D_LEAD])
+    if gap >= S.SENSOR_RANGE_M or _is_stop_line(obs, gap):
+        return True
+    leader_v = max(0.0, v - float(obs[S.DV]))
+    return gap + braking_distance(leader_v, LEADER_BRAKE_MPS) >= need
+
+
+def _stop_lines(obs: NDArray[np.floating], v: float) -> list[float]:
+    """Distances [m] of the stop lines the ego must not pass: red or yellow lights
+    (except a yellow it can no longer stop for) and occupied crossings."""
+    lines = []
+    d_cross = float(obs[S.D_CROSS])
+    if d_cross < S.SENSOR_RANGE_M:
+        lines.append(d_cross)
+    tls = round(float(obs[S.TLS]))
+    d_tl = float(obs[S.D_TL])
+    if d_tl < S.SENSOR_RANGE_M and tls != 0:
+        dilemma = tls == 1 and d_tl < v + braking_distance(v)
+        if not dilemma:
+            lines.append(d_tl)
+    return lines
+
+
+def _is_stop_line(obs: NDArray[np.floating], gap: float) -> bool:
+    light = round(float(obs[S.TLS])) != 0 and abs(gap - float(obs[S.D_TL])) <= VIRTUAL_TOL_M
+    cross = abs(gap - float(obs[S.D_CROSS])) <= VIRTUAL_TOL_M
+    return light or cross
+
+
+def shield(obs: NDArray[np.floating], q_values: Sequence[float]) -> ShieldDecision:
+    """The best-valued safe action for a raw observation."""
+    order = np.argsort(-np.asarray(q_values, dtype=np.float64), kind="stable")
+    for rank, a in enumerate(order):
+        if is_safe(obs, int(a)):
+            return ShieldDecision(int(a), overridden=rank > 0)
+    return ShieldDecision(action_index(-MAX_BRAKE_MPS), overridden=True)

@@ -1,0 +1,58 @@
+"""The kinematic safety shield against hand-computed cases."""
+
+import numpy as np
+import pytest
+
+from explaindrive.agent.shield import braking_distance, is_safe, shield
+from explaindrive.env.actions import action_index
+
+
+def obs(v=10.0, lim=13.89, d_lead=200.0, dv=0.0, d_tl=200.0, tls=0, d_cross=200.0):
+    return np.array([0, v, lim, d_lead, dv, d_tl, tls, d_cross], dtype=np.float32)
+
+
+@pytest.mark.parametrize(
+    ("v", "brake", "expected"),
+    [(13, 3, 22.0), (6, 3, 3.0), (3, 3, 0.0), (0, 3, 0.0), (10, 9, 1.0), (10, 4.5, 6.5)],
+)
+def test_braking_distance(v, brake, expected):
+    # 13 -> 10 + 7 + 4 + 1; 6 -> 3; 10 at 9 -> 1; 10 at 4.5 -> 5.5 + 1
+    assert braking_distance(v, brake) == pytest.approx(expected)
+
+
+def test_speed_limit():
+    assert is_safe(obs(v=10), action_index(3))  # 13 <= 13.89
+    assert not is_safe(obs(v=12), action_index(3))  # 15 > 13.89
+    assert is_safe(obs(v=17), action_index(-3))  # above the limit: braking hardest is allowed
+    assert not is_safe(obs(v=17), action_index(-2))
+
+
+def test_red_light_needs_a_stopping_option():
+    # v_new = 10: 10 + (7 + 4 + 1) + 2 = 24 <= 30; v_new = 13: 13 + 22 + 2 = 37 > 30
+    red = obs(v=10, d_lead=30, dv=10, d_tl=30, tls=2)
+    assert is_safe(red, action_index(0))
+    assert not is_safe(red, action_index(3))
+
+
+def test_yellow_inside_the_dilemma_zone_is_not_a_stop_line():
+    # at 13 m/s the ego needs 13 + 22 = 35 m: a yellow at 10 m cannot be stopped for
+    assert is_safe(obs(v=13, d_lead=10, dv=13, d_tl=10, tls=1), action_index(0))
+    assert not is_safe(obs(v=13, d_lead=10, dv=13, d_tl=10, tls=2), action_index(0))
+
+
+def test_real_leader_may_brake_at_9():
+    # leader at 10 m/s, 12 m ahead: it stops within 1 m; ego at v_new = 10 needs 24 m
+    assert not is_safe(obs(v=10, d_lead=12, dv=0), action_index(0))
+    # with 23 m: 23 + 1 = 24 >= 10 + 12 + 2 = 24
+    assert is_safe(obs(v=10, d_lead=23, dv=0), action_index(0))
+
+
+def test_shield_keeps_the_best_safe_action():
+    q = np.array([0, 1, 2, 3, 4, 5, 6], dtype=float)  # prefers +3
+    free = shield(obs(v=5), q)
+    assert free.action == action_index(3) and not free.overridden
+    red = shield(obs(v=10, d_lead=30, dv=10, d_tl=30, tls=2), q)
+    # +1: 11 + (8 + 5 + 2) + 2 = 28 <= 30; +2: 12 + (9 + 6 + 3) + 2 = 32 > 30
+    assert red.action == action_index(1) and red.overridden
+    wall = shield(obs(v=13, d_lead=1, dv=13, d_cross=1), q)
+    assert wall.action == action_index(-3) and wall.overridden
