@@ -109,7 +109,7 @@ class MergedController:
                     f"shipped policy not found: {p}; train one with "
                     f"`explaindrive train --mode {p.stem}` and copy its policy.pt/.json there"
                 )
-        return cls.from_files(*paths, use_shield=use_shield)
+        return cls.from_files(paths[0], paths[1], use_shield=use_shield)
 
     def set_command(self, command: Command | str | int) -> None:
         """Apply a passenger command; stop keeps the current agent."""

@@ -54,7 +54,8 @@ def _load_driver(policy: PolicySpec) -> Any:
     from explaindrive.agent.controller import MergedController, QPolicy
 
     if policy.kind == "merged":
-        return MergedController.from_files(*policy.paths, use_shield=policy.shield)
+        fast, comfort = policy.paths
+        return MergedController.from_files(fast, comfort, use_shield=policy.shield)
     agent = QPolicy.load(policy.paths[0])
     # One agent under its own command and stop: the merged controller over it twice.
     return MergedController(agent, agent, Command.parse(policy.primary), use_shield=policy.shield)
