@@ -89,7 +89,9 @@ def _is_stop_line(obs: NDArray[np.floating], gap: float) -> bool:
     return light or cross
 
 
-def shield(obs: NDArray[np.floating], q_values: Sequence[float]) -> ShieldDecision:
+def shield(
+    obs: NDArray[np.floating], q_values: Sequence[float] | NDArray[np.floating]
+) -> ShieldDecision:
     """The best-valued safe action for a raw observation."""
     order = np.argsort(-np.asarray(q_values, dtype=np.float64), kind="stable")
     for rank, a in enumerate(order):
