@@ -46,6 +46,8 @@ class EmbeddedConfig(_Strict):
     weights (tuned on the training split)."""
     none_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
     """Below this top probability a request is treated as off-topic; ``None`` = stored value."""
+    encoder_threads: int = Field(default=1, ge=1)
+    """torch threads while encoding a request (1 is fastest on a CPU shared with SUMO)."""
     cutoff_m: float = Field(default=SUMMARY_CUTOFF_M, gt=0.0)
     """[m] objects farther than this are ignored by the decider and the explainer."""
 

@@ -45,9 +45,16 @@ def default_embedding_model_dir() -> Path:
 class SentenceEncoder:
     """Lazily loaded, offline sentence-transformers encoder (unit-norm embeddings)."""
 
-    def __init__(self, model_dir: Path | None = None) -> None:
-        """Args: model_dir: model directory; ``None`` = the packaged all-MiniLM-L6-v2."""
+    def __init__(self, model_dir: Path | None = None, threads: int = 1) -> None:
+        """Build an encoder (the model loads on first use).
+
+        Args:
+            model_dir: model directory; ``None`` = the packaged all-MiniLM-L6-v2.
+            threads: torch threads used while encoding (restored afterwards); 1 keeps
+                short sentences fast on a CPU shared with a simulation.
+        """
         self.model_dir = model_dir
+        self.threads = threads
         self._model: Any = None
         self._lock = threading.Lock()
 
@@ -69,9 +76,16 @@ class SentenceEncoder:
     def encode(self, texts: list[str]) -> NDArray[np.float32]:
         """Embeddings of ``texts``, shape ``(len(texts), dim)``, each of unit norm."""
         self.load()
-        out = self._model.encode(
-            texts, batch_size=64, normalize_embeddings=True, show_progress_bar=False
-        )
+        import torch
+
+        previous = torch.get_num_threads()
+        torch.set_num_threads(self.threads)
+        try:
+            out = self._model.encode(
+                texts, batch_size=64, normalize_embeddings=True, show_progress_bar=False
+            )
+        finally:
+            torch.set_num_threads(previous)
         return np.asarray(out, dtype=np.float32)
 
 

@@ -35,7 +35,9 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
     ) -> None:
         """Args: config: backend options; encoder: share one loaded encoder between users."""
         self.config = config or EmbeddedConfig()
-        self.encoder = encoder or SentenceEncoder(self.config.embedding_model_dir)
+        self.encoder = encoder or SentenceEncoder(
+            self.config.embedding_model_dir, self.config.encoder_threads
+        )
         self.classifier = IntentClassifier.load(self.config.classifier_path)
 
     def load(self) -> None:
