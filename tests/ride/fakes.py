@@ -15,7 +15,7 @@ from explaindrive.language.decision import Conflict, Decision, ExplanationDecide
 from explaindrive.language.explanation import Explainer, Explanation
 from explaindrive.language.intent import IntentInterpreter, IntentResult, format_confirmation
 from explaindrive.language.summary import StateRecord
-from explaindrive.ride.language import LanguageStack
+from explaindrive.ride.language import RideLanguage
 
 
 class ScriptedController:
@@ -83,8 +83,8 @@ class EchoExplainer(Explainer):
         return Explanation(f"slowing for {factor}", factor, self.name)
 
 
-def fake_language(delay_s: float = 0.0) -> LanguageStack:
+def fake_language(delay_s: float = 0.0) -> RideLanguage:
     def transcribe(path: Path) -> str:
         return path.stem.replace("_", " ")
 
-    return LanguageStack(KeywordInterpreter(delay_s), BrakingDecider(), EchoExplainer(), transcribe)
+    return RideLanguage(KeywordInterpreter(delay_s), BrakingDecider(), EchoExplainer(), transcribe)

@@ -62,9 +62,8 @@ class LanguageLane:
         context: dict[str, Any] | None = None,
     ) -> Task:
         """Queue ``fn(*args)``; it must finish within ``deadline_s`` wall seconds."""
-        task = Task(
-            kind, self._pool.submit(_run, fn, args), time.monotonic(), deadline_s, context or {}
-        )
+        submitted = time.monotonic()  # before the worker can start
+        task = Task(kind, self._pool.submit(_run, fn, args), submitted, deadline_s, context or {})
         self._pending.append(task)
         return task
 

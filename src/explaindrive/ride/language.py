@@ -1,4 +1,4 @@
-"""The language modules a ride uses, behind one small record."""
+"""The language modules a ride calls, behind one small record."""
 
 from __future__ import annotations
 
@@ -12,17 +12,37 @@ from explaindrive.language.intent import IntentInterpreter
 
 
 @dataclass
-class LanguageStack:
+class RideLanguage:
     """LLM-1, LLM-2, LLM-3 and speech-to-text for a ride.
 
     Attributes:
         interpreter: LLM-1 (command interpretation with confirmation question).
         decider: LLM-2 (explain or not).
         explainer: LLM-3 (the explanation).
-        transcribe: speech-to-text of an audio file; returns "" for no speech.
+        transcribe: speech-to-text of an audio file; raises
+            :class:`explaindrive.language.speech.AudioError` for unusable audio.
     """
 
     interpreter: IntentInterpreter
     decider: ExplanationDecider
     explainer: Explainer
     transcribe: Callable[[Path], str]
+
+
+def build_language(backend: str = "embedded") -> RideLanguage:
+    """The language layer for ``backend`` (``embedded`` or ``openai``), models loaded.
+
+    Raises:
+        ValueError: for an unknown backend.
+    """
+    from explaindrive.language.stack import make_language_stack
+
+    stack = make_language_stack(backend)
+    load = getattr(stack.interpreter, "load", None)
+    if callable(load):
+        load()  # pay the embedding model's load before the ride starts
+
+    def transcribe(path: Path) -> str:
+        return stack.transcriber.transcribe(path).text
+
+    return RideLanguage(stack.interpreter, stack.decider, stack.explainer, transcribe)

@@ -34,7 +34,8 @@ from explaindrive.language.intent import IntentResult
 from explaindrive.language.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.lane import LanguageLane, Outcome
-from explaindrive.ride.language import LanguageStack
+from explaindrive.language.speech import AudioError
+from explaindrive.ride.language import RideLanguage
 
 log = logging.getLogger(__name__)
 
@@ -120,7 +121,7 @@ class RideSession:
         self,
         config: RideConfig,
         controller: MergedController,
-        language: LanguageStack,
+        language: RideLanguage,
         env: UrbanDriveEnv | None = None,
     ) -> None:
         self.config = config
@@ -201,17 +202,23 @@ class RideSession:
         )
         return req.id
 
-    def _interpret(self, req: _Request) -> tuple[str | None, IntentResult | None, float]:
-        """Worker side: transcribe if needed, then interpret."""
+    def _interpret(self, req: _Request) -> tuple[str, IntentResult | None, float, str | None]:
+        """Worker side: transcribe if needed, then interpret.
+
+        Returns (text, interpretation or None, transcription time, why there is no text).
+        """
         transcript_s = 0.0
-        text = req.text
+        text = req.text or ""
         if req.audio is not None:
             t0 = time.perf_counter()
-            text = self.language.transcribe(req.audio)
+            try:
+                text = self.language.transcribe(req.audio)
+            except AudioError as exc:
+                return "", None, time.perf_counter() - t0, str(exc)
             transcript_s = time.perf_counter() - t0
-            if not text:
-                return "", None, transcript_s
-        return text, self.language.interpreter.interpret(text or ""), transcript_s
+        if not text.strip():
+            return text, None, transcript_s, "empty request"
+        return text, self.language.interpreter.interpret(text), transcript_s, None
 
     # ------------------------------------------------------------------ control step
     def step(self) -> StepRecord:
@@ -294,7 +301,7 @@ class RideSession:
 
     def _on_interpretation(self, out: Outcome) -> None:
         req: _Request = out.task.context["request"]
-        text, result, transcribe_s = out.result
+        text, result, transcribe_s, problem = out.result
         if req.audio is not None:
             self._note(
                 {
@@ -310,6 +317,7 @@ class RideSession:
                 {
                     "type": "rephrase",
                     "id": req.id,
+                    "reason": problem,
                     "message": "Sorry, I did not catch that. Could you say it again?",
                 }
             )
