@@ -31,10 +31,10 @@ from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.language.decision import Decision
 from explaindrive.language.explanation import Explanation
 from explaindrive.language.intent import IntentResult
+from explaindrive.language.speech import AudioError
 from explaindrive.language.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.lane import LanguageLane, Outcome
-from explaindrive.language.speech import AudioError
 from explaindrive.ride.language import RideLanguage
 
 log = logging.getLogger(__name__)
