@@ -22,6 +22,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "explaindrive.cli.train",
     "explaindrive.cli.evaluate",
     "explaindrive.cli.report",
+    "explaindrive.cli.ride",
     "explaindrive.cli.interpret",
     "explaindrive.cli.explain",
     "explaindrive.cli.transcribe",
