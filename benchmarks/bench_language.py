@@ -24,7 +24,7 @@ from rich.table import Table
 
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
-    TEST_CSV,
+    DEV_CSV,
     data_path,
     load_commands,
     load_decisions,
@@ -55,7 +55,7 @@ def main() -> None:
     stack.interpreter.interpret("warm up")  # loads the encoder
     load_s = time.perf_counter() - t0
 
-    texts = [r.text for r in load_commands(data_path(TEST_CSV))]
+    texts = [r.text for r in load_commands(data_path(DEV_CSV))]
     records = [r.record() for r in load_decisions(data_path(DECISIONS_JSONL))]
     lat_i = []
     for k in range(args.n):

@@ -10,7 +10,7 @@ from explaindrive.language.backends.embedded import RuleDecider, TemplateExplain
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
-    TEST_CSV,
+    DEV_CSV,
     TRAIN_CSV,
     data_path,
     load_commands,
@@ -19,13 +19,13 @@ from explaindrive.language.datasets import (
 from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
 
 
-def test_corpus_sizes_and_held_out_split() -> None:
-    train, test = load_commands(data_path(TRAIN_CSV)), load_commands(data_path(TEST_CSV))
-    assert len(train) + len(test) >= 400 and len(test) >= 120
-    assert {r.text.lower() for r in train}.isdisjoint({r.text.lower() for r in test})
-    counts = Counter(r.label for r in test)
+def test_corpus_sizes_and_dev_split() -> None:
+    train, dev = load_commands(data_path(TRAIN_CSV)), load_commands(data_path(DEV_CSV))
+    assert len(train) + len(dev) >= 400 and len(dev) >= 120
+    assert {r.text.lower() for r in train}.isdisjoint({r.text.lower() for r in dev})
+    counts = Counter(r.label for r in dev)
     assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
-    assert {"direct", "indirect", "negation", "noise"} <= {r.kind for r in test}
+    assert {"direct", "indirect", "negation", "noise"} <= {r.kind for r in dev}
 
 
 def test_decision_set() -> None:

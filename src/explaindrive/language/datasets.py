@@ -27,7 +27,11 @@ def data_path(name: str) -> Path:
 
 
 TRAIN_CSV = "commands_train.csv"
+"""Training requests."""
+DEV_CSV = "commands_dev.csv"
+"""Development requests: used for model selection and the STOP threshold."""
 TEST_CSV = "commands_test.csv"
+"""Held-out requests, written before the current model and never used to build it."""
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 
