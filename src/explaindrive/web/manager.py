@@ -240,7 +240,8 @@ class RideManager:
             self._session = session
             session.start(Command.parse(settings.command))
         except Exception as exc:
-            log.exception("the ride could not start")
+            log.error("the ride could not start: %s", exc)
+            log.debug("start failure", exc_info=True)
             self._end_session()
             with self._lock:
                 self._state = RideState.FAILED
