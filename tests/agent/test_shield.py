@@ -34,10 +34,19 @@ def test_red_light_needs_a_stopping_option():
     assert not is_safe(red, action_index(3))
 
 
-def test_yellow_inside_the_dilemma_zone_is_not_a_stop_line():
-    # at 13 m/s the ego needs 13 + 22 = 35 m: a yellow at 10 m cannot be stopped for
-    assert is_safe(obs(v=13, d_lead=10, dv=13, d_tl=10, tls=1), action_index(0))
+def test_yellow_inside_the_dilemma_zone_means_go():
+    # braking hardest from 13: 10 + (7 + 4 + 1) + 2 = 24 m > 10 m: it cannot stop, so it goes
+    yellow = obs(v=13, d_lead=10, dv=13, d_tl=10, tls=1)
+    assert is_safe(yellow, action_index(0))
+    assert not is_safe(yellow, action_index(-1))  # slowing would strand it at red
     assert not is_safe(obs(v=13, d_lead=10, dv=13, d_tl=10, tls=2), action_index(0))
+
+
+def test_yellow_it_can_still_stop_for_is_a_stop_line():
+    # from 12 braking hardest: 9 + (6 + 3) + 2 = 20 m <= 29.9 m: it must stop
+    yellow = obs(v=12, d_lead=29.9, dv=12, d_tl=29.9, tls=1)
+    assert not is_safe(yellow, action_index(0))  # 12 + (9 + 6 + 3) + 2 = 32 > 29.9
+    assert is_safe(yellow, action_index(-1))  # 11 + (8 + 5 + 2) + 2 = 28 <= 29.9
 
 
 def test_real_leader_may_brake_at_9():

@@ -7,8 +7,9 @@ deceleration), and which does not
 exceed the posted limit. If no action qualifies, it brakes as hard as it can.
 
 Red and yellow lights and occupied crossings are stop lines the ego must be able
-to stop before; a yellow light the ego can no longer stop for is not (the
-dilemma zone): braking would only leave the car on the junction at red.
+to stop before; a yellow light that even the hardest braking cannot stop for is
+not (the dilemma zone): there the ego goes on without slowing down, since
+braking would only leave it on the junction at red.
 The shield is off during training; it is a runtime guard in the controller.
 """
 
@@ -56,10 +57,12 @@ def is_safe(obs: NDArray[np.floating], action: int) -> bool:
     v_new = max(0.0, v + SPEED_CHANGES_MPS[action])
     if v_new > float(obs[S.V_LIM]) and v_new > v - MAX_BRAKE_MPS + 1e-9:
         return False
-    need = v_new + braking_distance(v_new) + MARGIN_M  # [m] to a standstill after this step
-    for stop_line in _stop_lines(obs, v):
-        if need > stop_line:
-            return False
+    lines, must_go = _stop_lines(obs, v)
+    if must_go and v_new < v:
+        return False  # committed to a yellow it cannot stop for: clear it quickly
+    need = _stopping_need(v_new)
+    if any(need > line for line in lines):
+        return False
     gap = float(obs[S.D_LEAD])
     if gap >= S.SENSOR_RANGE_M or _is_stop_line(obs, gap):
         return True
@@ -67,20 +70,31 @@ def is_safe(obs: NDArray[np.floating], action: int) -> bool:
     return gap + braking_distance(leader_v, LEADER_BRAKE_MPS) >= need
 
 
-def _stop_lines(obs: NDArray[np.floating], v: float) -> list[float]:
-    """Distances [m] of the stop lines the ego must not pass: red or yellow lights
-    (except a yellow it can no longer stop for) and occupied crossings."""
+def _stopping_need(v_new: float) -> float:
+    """[m] from the ego's front to where it stands still after this step and braking."""
+    return v_new + braking_distance(v_new) + MARGIN_M
+
+
+def _stop_lines(obs: NDArray[np.floating], v: float) -> tuple[list[float], bool]:
+    """Stop lines the ego must not pass, and whether it is committed to go.
+
+    Red and yellow lights and occupied crossings are stop lines, except a yellow
+    light that even the hardest braking now cannot stop for (the dilemma zone):
+    then the ego must go on without slowing down.
+    """
     lines = []
     d_cross = float(obs[S.D_CROSS])
     if d_cross < S.SENSOR_RANGE_M:
         lines.append(d_cross)
     tls = round(float(obs[S.TLS]))
     d_tl = float(obs[S.D_TL])
+    must_go = False
     if d_tl < S.SENSOR_RANGE_M and tls != 0:
-        dilemma = tls == 1 and d_tl < v + braking_distance(v)
-        if not dilemma:
+        hardest = max(0.0, v - MAX_BRAKE_MPS)
+        must_go = tls == 1 and _stopping_need(hardest) > d_tl
+        if not must_go:
             lines.append(d_tl)
-    return lines
+    return lines, must_go
 
 
 def _is_stop_line(obs: NDArray[np.floating], gap: float) -> bool:

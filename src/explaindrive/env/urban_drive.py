@@ -239,7 +239,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep.steps += 1
         sim = api.simulation.getSubscriptionResults()
         collided = bool(sim.get(tc.VAR_COLLIDING_VEHICLES_IDS)) and self._ego_collided()
-        arrived = EGO_ID in sim.get(tc.VAR_ARRIVED_VEHICLES_IDS, ())
+        arrived = not collided and EGO_ID in sim.get(tc.VAR_ARRIVED_VEHICLES_IDS, ())
         present = not collided and not arrived
         if present:
             ego = api.vehicle.getSubscriptionResults(EGO_ID)
