@@ -6,11 +6,13 @@ from collections import Counter
 
 import pytest
 
+from explaindrive.commands import Command
 from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
     DEV_CSV,
+    TEST_CSV,
     TRAIN_CSV,
     data_path,
     load_commands,
@@ -26,6 +28,22 @@ def test_corpus_sizes_and_dev_split() -> None:
     counts = Counter(r.label for r in dev)
     assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
     assert {"direct", "indirect", "negation", "noise"} <= {r.kind for r in dev}
+
+
+def test_held_out_test_split() -> None:
+    test = load_commands(data_path(TEST_CSV))
+    assert len(test) >= 130
+    counts = Counter(r.label for r in test)
+    assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
+    assert {"direct", "indirect", "negation", "noise", "offtopic"} <= {r.kind for r in test}
+    seen = {r.text.lower() for name in (TRAIN_CSV, DEV_CSV) for r in load_commands(data_path(name))}
+    assert seen.isdisjoint({r.text.lower() for r in test})
+
+
+def test_shipped_classifier_keeps_stop_recall_on_dev(interpreter) -> None:  # type: ignore[no-untyped-def]
+    rows = [r for r in load_commands(data_path(DEV_CSV)) if r.label == "stop"]
+    missed = [r.text for r in rows if interpreter.interpret(r.text).intent is not Command.STOP]
+    assert missed == []
 
 
 def test_decision_set() -> None:

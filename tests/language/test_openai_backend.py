@@ -4,7 +4,7 @@ good replies, malformed replies, slow replies (timeouts) and HTTP 500."""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from explaindrive.commands import Command
 from explaindrive.language.backends.embedded import (
@@ -23,6 +23,9 @@ from explaindrive.language.backends.openai import (
 from explaindrive.language.config import OpenAIConfig
 from explaindrive.language.decision import Factor
 from explaindrive.language.summary import StateRecord
+
+if TYPE_CHECKING:
+    from tests.language.conftest import ScriptedOpenAI
 
 RED = StateRecord.model_validate(
     {
@@ -59,8 +62,8 @@ def test_tampered_reply_falls_back(openai_server, interpreter) -> None:  # type:
 
 
 def test_http_500_and_timeout_fall_back(
-    openai_server, interpreter: EmbeddedIntentInterpreter
-) -> None:  # type: ignore[no-untyped-def]
+    openai_server: ScriptedOpenAI, interpreter: EmbeddedIntentInterpreter
+) -> None:
     openai_server.script = [("http", 500)]
     r = OpenAIIntentInterpreter(client(openai_server), interpreter).interpret("Pull over now")
     assert r.fallback and r.intent is Command.STOP and "500" in (r.error or "")

@@ -1,7 +1,10 @@
-"""Sentence features for the embedded LLM-1: MiniLM embeddings plus hashed word n-grams.
+"""Sentence features for the embedded LLM-1: MiniLM embeddings, hashed word n-grams and
+lexical direction cues.
 
-The embedding carries meaning ("I'm late" ~ faster); the hashed n-grams carry the
-negations and short phrases embeddings blur ("stop speeding" is comfort, not stop).
+The embedding carries meaning ("I'm late" ~ faster); the hashed n-grams carry short
+phrases; the cues (:mod:`explaindrive.language.cues`) make direction and negation
+explicit, which embeddings blur ("go a bit slower" ~ "go a bit faster"; "stop speeding"
+is comfort, not stop).
 """
 
 from __future__ import annotations
@@ -18,10 +21,13 @@ import numpy as np
 from numpy.typing import NDArray
 from sklearn.feature_extraction.text import HashingVectorizer
 
+from explaindrive.language.cues import N_CUES, cue_features
+
 log = logging.getLogger(__name__)
 
 HASH_FEATURES = 2**12
 NGRAM_WEIGHT = 1.5  # scale of the (l2-normalised) n-gram block next to the unit embedding
+CUE_WEIGHT = 1.0  # scale of the cue counts
 
 
 def default_embedding_model_dir() -> Path:
@@ -117,16 +123,31 @@ class FeatureSpec:
 
     hash_features: int = HASH_FEATURES
     ngram_weight: float = NGRAM_WEIGHT
+    cue_weight: float = CUE_WEIGHT
+    n_cues: int = N_CUES
 
 
 def features(
     encoder: SentenceEncoder, texts: list[str], spec: FeatureSpec = FeatureSpec()
 ) -> NDArray[np.float32]:
-    """The classifier's input: ``[embedding | ngram_weight * ngrams]``."""
-    if spec.hash_features != HASH_FEATURES:
+    """The classifier's input: ``[embedding | ngram_weight * ngrams | cue_weight * cues]``."""
+    return features_from_embeddings(encoder.encode([normalize_text(t) for t in texts]), texts, spec)
+
+
+def features_from_embeddings(
+    emb: NDArray[np.float32], texts: list[str], spec: FeatureSpec = FeatureSpec()
+) -> NDArray[np.float32]:
+    """:func:`features` for texts whose embeddings ``emb`` are already computed.
+
+    Raises:
+        ValueError: if ``spec`` was built by a different feature layout (retrain).
+    """
+    if spec.hash_features != HASH_FEATURES or spec.n_cues != N_CUES:
         raise ValueError(
-            f"classifier expects {spec.hash_features} hashed features, this code builds "
-            f"{HASH_FEATURES}; retrain with `python -m explaindrive.language.intent_training`"
+            f"classifier expects {spec.hash_features} hashed features and {spec.n_cues} cues, "
+            f"this code builds {HASH_FEATURES} and {N_CUES}; retrain with "
+            "`python -m explaindrive.language.intent_classifier`"
         )
-    emb = encoder.encode([normalize_text(t) for t in texts])
-    return np.hstack([emb, spec.ngram_weight * ngram_features(texts)]).astype(np.float32)
+    return np.hstack(
+        [emb, spec.ngram_weight * ngram_features(texts), spec.cue_weight * cue_features(texts)]
+    ).astype(np.float32)

@@ -1,12 +1,17 @@
-"""The embedded LLM-1 classifier: logistic regression on sentence features, blended
-with a nearest-neighbour vote over the training requests' embeddings.
+"""The embedded LLM-1 classifier: logistic regression on sentence features (embedding,
+word n-grams, direction cues), blended with a nearest-neighbour vote over the training
+requests' embeddings.
 
-Hyper-parameters (``DEFAULT_C``, ``NGRAM_WEIGHT``, ``KNN_TEMPERATURE``, ``LR_WEIGHT``) were
-chosen by 5-fold cross-validation on the training split only.
+Protocol: the hyper-parameters (:class:`Hyper`: C, n-gram and cue weights, blend) are
+chosen on the development split by a model fitted on the training split only; the shipped
+model is then refitted on training + development requests. The held-out test split is
+never read here.
 
-STOP is safety-critical: it wins whenever its probability reaches ``stop_threshold``,
-tuned on out-of-fold probabilities of the training split to minimise a cost in which a
-missed STOP counts ``STOP_MISS_COST`` times a false STOP. Retrain and re-ship the weights with::
+STOP is safety-critical: it wins whenever its probability reaches ``stop_threshold``. The
+threshold minimises a cost in which a missed STOP counts ``STOP_MISS_COST`` times a false
+STOP on out-of-fold probabilities of training + development requests, capped so that every
+development STOP request (out of fold) still reaches it. Retrain and re-ship the weights
+with::
 
     python -m explaindrive.language.intent_classifier
 """
@@ -14,6 +19,7 @@ missed STOP counts ``STOP_MISS_COST`` times a false STOP. Retrain and re-ship th
 from __future__ import annotations
 
 import argparse
+import itertools
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,23 +31,50 @@ from sklearn.model_selection import StratifiedKFold
 
 from explaindrive.language.datasets import (
     CLASSIFIER_NPZ,
+    DEV_CSV,
     INTENT_LABELS,
     TRAIN_CSV,
+    CommandExample,
     data_path,
     load_commands,
 )
-from explaindrive.language.features import FeatureSpec, SentenceEncoder, features
+from explaindrive.language.features import (
+    FeatureSpec,
+    SentenceEncoder,
+    features_from_embeddings,
+    normalize_text,
+)
 
 log = logging.getLogger(__name__)
 
 STOP = INTENT_LABELS.index("stop")
 NONE = INTENT_LABELS.index("none")
-DEFAULT_C = 100.0  # inverse L2 strength of the logistic regression
 KNN_TEMPERATURE = 0.05  # softmax temperature over per-class best cosine similarities
-LR_WEIGHT = 0.5  # p = LR_WEIGHT * p_logreg + (1 - LR_WEIGHT) * p_knn
 STOP_MISS_COST = 5.0  # a missed STOP costs this many false STOPs when tuning the threshold
 MAX_STOP_THRESHOLD = 0.5
 MIN_STOP_THRESHOLD = 0.1
+
+
+@dataclass(frozen=True, slots=True)
+class Hyper:
+    """Hyper-parameters of the classifier (chosen on the development split)."""
+
+    c: float = 100.0
+    """Inverse L2 strength of the logistic regression."""
+    ngram_weight: float = 1.5
+    """Scale of the l2-normalised word n-gram block."""
+    cue_weight: float = 1.0
+    """Scale of the direction-cue counts."""
+    lr_weight: float = 0.5
+    """Blend: ``p = lr_weight * p_logreg + (1 - lr_weight) * p_knn``."""
+
+
+SELECTION_GRID: dict[str, tuple[float, ...]] = {
+    "c": (10.0, 100.0),
+    "ngram_weight": (1.0, 1.5),
+    "cue_weight": (0.0, 0.5, 1.0, 2.0),
+    "lr_weight": (0.35, 0.5, 0.75, 1.0),
+}
 
 
 @dataclass(frozen=True)
@@ -55,6 +88,7 @@ class IntentClassifier:
     stop_threshold: float
     none_threshold: float
     spec: FeatureSpec = field(default_factory=FeatureSpec)
+    lr_weight: float = 0.5  # p = lr_weight * p_logreg + (1 - lr_weight) * p_knn
 
     def proba(self, x: NDArray[np.floating]) -> NDArray[np.float64]:
         """Class probabilities for feature rows ``x`` (``[embedding | n-grams]``)."""
@@ -62,8 +96,10 @@ class IntentClassifier:
             raise ValueError(f"expected features of width {self.coef.shape[1]}, got {x.shape}")
         p_lr = _softmax(x @ self.coef.T + self.intercept)
         dim = self.ref_embeddings.shape[1]
+        if self.lr_weight >= 1.0:
+            return p_lr
         p_knn = knn_proba(x[:, :dim], self.ref_embeddings, self.ref_labels)
-        return LR_WEIGHT * p_lr + (1.0 - LR_WEIGHT) * p_knn
+        return self.lr_weight * p_lr + (1.0 - self.lr_weight) * p_knn
 
     def decide(
         self,
@@ -94,6 +130,9 @@ class IntentClassifier:
             none_threshold=self.none_threshold,
             hash_features=self.spec.hash_features,
             ngram_weight=self.spec.ngram_weight,
+            cue_weight=self.spec.cue_weight,
+            n_cues=self.spec.n_cues,
+            lr_weight=self.lr_weight,
         )
 
     @classmethod
@@ -117,7 +156,13 @@ class IntentClassifier:
                     ref_labels=np.asarray(z["ref_labels"], dtype=np.int64),
                     stop_threshold=float(z["stop_threshold"]),
                     none_threshold=float(z["none_threshold"]),
-                    spec=FeatureSpec(int(z["hash_features"]), float(z["ngram_weight"])),
+                    spec=FeatureSpec(
+                        int(z["hash_features"]),
+                        float(z["ngram_weight"]),
+                        float(z["cue_weight"]),
+                        int(z["n_cues"]),
+                    ),
+                    lr_weight=float(z["lr_weight"]),
                 )
         except (OSError, KeyError, ValueError) as exc:
             raise ValueError(f"{p}: not a valid intent classifier file ({exc})") from exc
@@ -161,65 +206,171 @@ def tune_stop_threshold(p_stop: NDArray[np.floating], is_stop: NDArray[np.bool_]
 
 
 def _fit(x: NDArray[np.float32], y: NDArray[np.int64], c: float) -> LogisticRegression:
-    model = LogisticRegression(C=c, max_iter=2000, class_weight="balanced")
+    model = LogisticRegression(C=c, max_iter=3000, class_weight="balanced")
     model.fit(x, y)
     return model
 
 
-def train(
-    texts: list[str],
-    labels: list[str],
-    encoder: SentenceEncoder,
-    *,
-    c: float = DEFAULT_C,
-    folds: int = 5,
-    seed: int = 0,
+def _classifier(
+    model: LogisticRegression,
+    x: NDArray[np.float32],
+    y: NDArray[np.int64],
+    dim: int,
+    spec: FeatureSpec,
+    hyper: Hyper,
+    stop_threshold: float = MAX_STOP_THRESHOLD,
 ) -> IntentClassifier:
-    """Train on labelled requests and tune the STOP threshold by cross-validation.
-
-    The STOP threshold is the one in [0.1, 0.5] (step 0.01) that minimises
-    ``STOP_MISS_COST * missed STOPs + false STOPs`` on out-of-fold probabilities
-    (ties: the lowest threshold).
-    """
-    spec = FeatureSpec()
-    x = features(encoder, texts, spec)
-    y = np.array([INTENT_LABELS.index(label) for label in labels], dtype=np.int64)
-    dim = x.shape[1] - spec.hash_features
-    oof = np.zeros((len(y), len(INTENT_LABELS)))
-    for tr, va in StratifiedKFold(folds, shuffle=True, random_state=seed).split(x, y):
-        fold = _fit(x[tr], y[tr], c)
-        oof[va] = IntentClassifier(
-            fold.coef_, fold.intercept_, x[tr, :dim], y[tr], MAX_STOP_THRESHOLD, 0.0, spec
-        ).proba(x[va])
-    stop_t = tune_stop_threshold(oof[:, STOP], y == STOP)
-    model = _fit(x, y, c)
-    clf = IntentClassifier(
+    return IntentClassifier(
         model.coef_.astype(np.float64),
         model.intercept_.astype(np.float64),
         ref_embeddings=x[:, :dim].copy(),
-        ref_labels=y,
-        stop_threshold=stop_t,
+        ref_labels=y.copy(),
+        stop_threshold=stop_threshold,
         none_threshold=0.0,
         spec=spec,
+        lr_weight=hyper.lr_weight,
     )
-    cv_pred = [clf.decide(row) for row in oof]
-    cv_acc = float(np.mean([p == t for p, t in zip(cv_pred, labels, strict=True)]))
-    log.info("cross-validated accuracy %.3f, stop threshold %.3f", cv_acc, stop_t)
+
+
+def recall_stop_threshold(p_stop: NDArray[np.floating], is_stop: NDArray[np.bool_]) -> float:
+    """Highest threshold on the 0.01 grid at which every STOP row still reaches it."""
+    if not is_stop.any():
+        return MAX_STOP_THRESHOLD
+    t = np.floor(float(np.min(p_stop[is_stop])) * 100.0) / 100.0
+    return float(np.clip(t, MIN_STOP_THRESHOLD, MAX_STOP_THRESHOLD))
+
+
+@dataclass(frozen=True, slots=True)
+class Encoded:
+    """Labelled requests with their sentence embeddings (computed once)."""
+
+    texts: list[str]
+    y: NDArray[np.int64]
+    emb: NDArray[np.float32]
+
+    @classmethod
+    def of(cls, rows: list[CommandExample], encoder: SentenceEncoder) -> Encoded:
+        texts = [r.text for r in rows]
+        y = np.array([INTENT_LABELS.index(r.label) for r in rows], dtype=np.int64)
+        return cls(texts, y, encoder.encode([normalize_text(t) for t in texts]))
+
+    def features(self, spec: FeatureSpec) -> NDArray[np.float32]:
+        return features_from_embeddings(self.emb, self.texts, spec)
+
+
+@dataclass(frozen=True, slots=True)
+class Selection:
+    """Outcome of the hyper-parameter search on the development split."""
+
+    hyper: Hyper
+    dev_accuracy: float  # 4-class accuracy on dev (none included), train-only model
+    dev_stop_threshold: float  # highest threshold keeping dev STOP recall at 1.0
+    dev_false_stops: int
+
+
+def select(train: Encoded, dev: Encoded, grid: dict[str, tuple[float, ...]]) -> Selection:
+    """Pick the hyper-parameters whose train-only model is most accurate on dev.
+
+    For each candidate the STOP threshold is the highest one that keeps STOP recall on
+    dev at 1.0; ties go to fewer false STOPs, then to the earlier candidate in the grid.
+    """
+    dim = train.emb.shape[1]
+    best: tuple[float, int, Selection] | None = None
+    for c, ngram_w, cue_w in itertools.product(grid["c"], grid["ngram_weight"], grid["cue_weight"]):
+        spec = FeatureSpec(ngram_weight=ngram_w, cue_weight=cue_w)
+        x_tr, x_dev = train.features(spec), dev.features(spec)
+        model = _fit(x_tr, train.y, c)
+        for lr_w in grid["lr_weight"]:
+            hyper = Hyper(c, ngram_w, cue_w, lr_w)
+            clf = _classifier(model, x_tr, train.y, dim, spec, hyper)
+            p = clf.proba(x_dev)
+            t = recall_stop_threshold(p[:, STOP], dev.y == STOP)
+            pred = np.array([INTENT_LABELS.index(clf.decide(row, t)) for row in p])
+            acc = float(np.mean(pred == dev.y))
+            false_stops = int(np.sum((pred == STOP) & (dev.y != STOP)))
+            log.info(
+                "C=%g ngram=%g cue=%g lr=%g: dev accuracy %.3f, threshold %.2f, false STOPs %d",
+                c,
+                ngram_w,
+                cue_w,
+                lr_w,
+                acc,
+                t,
+                false_stops,
+            )
+            if best is None or (acc, -false_stops) > (best[0], best[1]):
+                best = (acc, -false_stops, Selection(hyper, acc, t, false_stops))
+    assert best is not None
+    return best[2]
+
+
+def fit_final(
+    train: Encoded, dev: Encoded, hyper: Hyper, *, folds: int = 5, seed: int = 0
+) -> IntentClassifier:
+    """Fit on training + development requests; calibrate the STOP threshold out of fold.
+
+    The threshold minimises ``STOP_MISS_COST * missed STOPs + false STOPs`` on 5-fold
+    out-of-fold probabilities of all requests and is then lowered, if needed, so that every
+    development STOP request (out of fold) reaches it.
+    """
+    spec = FeatureSpec(ngram_weight=hyper.ngram_weight, cue_weight=hyper.cue_weight)
+    x = np.vstack([train.features(spec), dev.features(spec)])
+    y = np.concatenate([train.y, dev.y])
+    from_dev = np.r_[np.zeros(len(train.y), bool), np.ones(len(dev.y), bool)]
+    dim = train.emb.shape[1]
+    oof = np.zeros((len(y), len(INTENT_LABELS)))
+    for tr, va in StratifiedKFold(folds, shuffle=True, random_state=seed).split(x, y):
+        fold = _fit(x[tr], y[tr], hyper.c)
+        oof[va] = _classifier(fold, x[tr], y[tr], dim, spec, hyper).proba(x[va])
+    t_cost = tune_stop_threshold(oof[:, STOP], y == STOP)
+    t_dev = recall_stop_threshold(oof[from_dev, STOP], y[from_dev] == STOP)
+    stop_t = min(t_cost, t_dev)
+    clf = _classifier(_fit(x, y, hyper.c), x, y, dim, spec, hyper, stop_t)
+    pred = np.array([INTENT_LABELS.index(clf.decide(row)) for row in oof])
+    log.info(
+        "out-of-fold (train+dev) accuracy %.3f, STOP recall %.3f; stop threshold %.2f "
+        "(cost %.2f, dev recall %.2f)",
+        float(np.mean(pred == y)),
+        float(np.mean(pred[y == STOP] == STOP)),
+        stop_t,
+        t_cost,
+        t_dev,
+    )
     return clf
 
 
+def train(
+    train_rows: list[CommandExample],
+    dev_rows: list[CommandExample],
+    encoder: SentenceEncoder,
+    grid: dict[str, tuple[float, ...]] | None = None,
+) -> tuple[IntentClassifier, Selection]:
+    """Select hyper-parameters on dev, then fit the shipped model on train + dev."""
+    tr, dev = Encoded.of(train_rows, encoder), Encoded.of(dev_rows, encoder)
+    sel = select(tr, dev, grid or SELECTION_GRID)
+    log.info(
+        "selected %s: dev accuracy %.3f (train-only model), dev STOP threshold %.2f, "
+        "false STOPs %d",
+        sel.hyper,
+        sel.dev_accuracy,
+        sel.dev_stop_threshold,
+        sel.dev_false_stops,
+    )
+    return fit_final(tr, dev, sel.hyper), sel
+
+
 def main(argv: list[str] | None = None) -> None:
-    """Retrain the shipped classifier from the shipped training split."""
+    """Retrain the shipped classifier from the shipped training and development splits."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data", type=Path, default=data_path(TRAIN_CSV))
+    parser.add_argument("--train", type=Path, default=data_path(TRAIN_CSV))
+    parser.add_argument("--dev", type=Path, default=data_path(DEV_CSV))
     parser.add_argument("--out", type=Path, default=data_path(CLASSIFIER_NPZ))
-    parser.add_argument("--c", type=float, default=DEFAULT_C)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    rows = load_commands(args.data)
-    clf = train([r.text for r in rows], [r.label for r in rows], SentenceEncoder(), c=args.c)
+    train_rows, dev_rows = load_commands(args.train), load_commands(args.dev)
+    clf, _ = train(train_rows, dev_rows, SentenceEncoder())
     clf.save(args.out)
-    log.info("wrote %s (%d examples)", args.out, len(rows))
+    log.info("wrote %s (%d + %d examples)", args.out, len(train_rows), len(dev_rows))
 
 
 if __name__ == "__main__":

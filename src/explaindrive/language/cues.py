@@ -1,0 +1,224 @@
+"""Lexical direction cues for the embedded LLM-1: faster, slower, stop, and their negations.
+
+Sentence embeddings place "go a bit faster" and "go a bit slower" close together and
+read "stop" in "stop speeding" as a request to stop. These features make the direction
+explicit: each word of a small lexicon is counted as a plain cue, or as a negated cue
+when it falls in the scope of a negator ("don't", "no need to", "too", "stop"/"quit"
+before a gerund). Cue words are matched with a small edit tolerance so that typed or
+transcribed typos ("slowr", "fastr") still count.
+
+The features are general (word classes, negation scope, the part of speech of "stop");
+they are combined with the sentence embedding and weighted by the classifier.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+
+def _words(text: str) -> frozenset[str]:
+    return frozenset(text.split())
+
+
+# Direction words. "speed" alone is neutral ("reduce the speed", "this speed scares me").
+FAST_WORDS = _words(
+    """fast faster fastest quick quicker quickly quicken hurry hurrying hurried rush
+    rushing rushed accelerate accelerating acceleration race racing speeding
+    sooner asap urgent urgently late briskly brisk throttle zoom increase raise"""
+)
+SLOW_WORDS = _words(
+    """slow slower slowly slowing slowed careful carefully cautious cautiously gentle
+    gently gentler calm calmly calmer easy easier ease relax relaxed smooth smoothly
+    smoother soft softly softer steady steadily comfortable comfortably safely
+    decelerate decrease reduce lower less early"""
+)
+# Complaints about the pace: slowness words ask for more speed, recklessness words for less.
+TOO_SLOW_WORDS = _words(
+    """crawl crawling crawls dawdle dawdling dawdles dilly dallying snail turtle creep
+    creeping crawling dragging drag poking lagging hesitating timid idling sluggish"""
+)
+TOO_FAST_WORDS = _words(
+    """reckless recklessly maniac aggressive aggressively swerving swerve tailgating
+    abrupt abruptly harsh harshly jerky jerking sudden suddenly rough roughly bumpy
+    slamming slam stomping tearing"""
+)
+# Requests to stop the trip, and words of continuing (negated: "no further").
+STOP_VERBS = _words("stop halt park stopping")
+# Common words that look like cue words with a typo but are not ("speed" is neutral).
+_NOT_TYPOS = _words("speed speeds sped")
+STOP_PHRASES: tuple[tuple[str, ...], ...] = (
+    ("pull", "over"),
+    ("pull", "up"),
+    ("pull", "in"),
+    ("let", "me", "out"),
+    ("let", "me", "off"),
+    ("let", "us", "out"),
+    ("drop", "me"),
+    ("get", "out"),
+    ("get", "off"),
+    ("lemme",),
+)
+CONTINUE_WORDS = _words("further farther continue continuing anymore another beyond past")
+NEGATORS = _words(
+    """not no don't dont never needn't neednt isn't isnt aren't arent won't wont
+    shouldn't cannot can't without quit too"""
+)
+# "stop" before these is not a request to stop ("stop being so slow").
+_DETERMINERS = _words("the that this a an your those these last next sudden hard")
+_POSSESSIVES = _words("my our")
+_NOT_GERUNDS = _words(
+    """something nothing anything everything thing king morning evening building parking
+    ring during bring string spring ceiling"""
+)
+SCOPE_TOKENS = 4  # a negator governs this many following words within its clause
+
+# Multi-word direction cues; the phrase is negated when its first word is.
+FAST_PHRASES: tuple[tuple[str, ...], ...] = (
+    ("speed", "up"),
+    ("speed", "it", "up"),
+    ("speeding", "up"),
+    ("pick", "up"),
+    ("pick", "it", "up"),
+    ("step", "on", "it"),
+    ("get", "going"),
+    ("get", "moving"),
+    ("get", "a", "move"),
+    ("move", "it"),
+    ("foot", "down"),
+    ("more", "speed"),
+    ("go", "go"),
+)
+SLOW_PHRASES: tuple[tuple[str, ...], ...] = (
+    ("take", "your", "time"),
+    ("ease", "off"),
+    ("ease", "up"),
+    ("back", "off"),
+    ("take", "it", "easy"),
+)
+_LEXICON: tuple[str, ...] = tuple(
+    sorted(FAST_WORDS | SLOW_WORDS | TOO_SLOW_WORDS | TOO_FAST_WORDS | STOP_VERBS | {"stops"})
+)
+_TOKEN_RE = re.compile(r"[a-z']+|[.,!?;:]")
+_CLAUSE_BREAKS = frozenset(".,!?;:") | {"but", "and", "because"}
+
+CUE_NAMES: tuple[str, ...] = (
+    "fast",  # faster, hurry, late ... not negated
+    "slow",  # slower, careful, gently ... not negated
+    "neg_fast",  # "don't go so fast", "no need to hurry", "stop speeding", "too fast"
+    "neg_slow",  # "don't be so careful", "too slow", "stop being so slow"
+    "too_slow",  # "crawling", "dawdling", "like a snail"
+    "too_fast",  # "reckless", "abrupt", "slamming"
+    "stop_request",  # "stop", "halt", "pull over", "let me out" used as a request
+    "stop_noun",  # "that stop was too abrupt", "your stops"
+    "stop_destination",  # "this is my stop"
+    "neg_continue",  # "no further", "don't continue", "not another block"
+)
+N_CUES = len(CUE_NAMES)
+_INDEX = {name: i for i, name in enumerate(CUE_NAMES)}
+
+
+def tokenize(text: str) -> list[str]:
+    """Lower-case word and punctuation tokens (curly apostrophes unified)."""
+    return _TOKEN_RE.findall(text.lower().replace("\u2019", "'"))
+
+
+@lru_cache(maxsize=4096)
+def canonical(token: str) -> str:
+    """The lexicon word ``token`` spells (allowing a typo), else ``token``.
+
+    Repeated letters are squeezed first ("slooow" -> "slow"); tokens shorter than four
+    letters must match exactly, and a typo never changes the first letter.
+    """
+    if token in _LEXICON or token in _NOT_TYPOS or len(token) < 4:
+        return token
+    squeezed = re.sub(r"(.)\1{2,}", r"\1", token)
+    if squeezed in _LEXICON:
+        return squeezed
+    squeezed = re.sub(r"(.)\1+", r"\1", squeezed)
+    if squeezed in _LEXICON:
+        return squeezed
+    match = difflib.get_close_matches(token, _LEXICON, n=1, cutoff=0.85)
+    return match[0] if match and match[0][0] == token[0] else token
+
+
+def _is_gerund(token: str) -> bool:
+    return token.endswith("ing") and len(token) >= 5 and token not in _NOT_GERUNDS
+
+
+def _in_scope(tokens: list[str], negated: list[bool], start: int) -> None:
+    """Mark up to SCOPE_TOKENS words after ``start`` as negated, stopping at a clause break."""
+    for j in range(start + 1, min(len(tokens), start + 1 + SCOPE_TOKENS)):
+        if tokens[j] in _CLAUSE_BREAKS:
+            break
+        negated[j] = True
+
+
+def cue_vector(text: str) -> NDArray[np.float32]:
+    """Counts of each cue in :data:`CUE_NAMES` for one request (each capped at 2)."""
+    raw = tokenize(text)
+    tokens = [canonical(t) for t in raw]
+    n = len(tokens)
+    negated = [False] * n
+    stop_role: dict[int, str] = {}
+    for i, t in enumerate(tokens):
+        nxt = tokens[i + 1] if i + 1 < n else ""
+        prev = tokens[i - 1] if i > 0 else ""
+        if t in NEGATORS or (t == "need" and prev == "no"):
+            _in_scope(tokens, negated, i)
+        elif t in ("stop", "quit") and (_is_gerund(nxt) or nxt == "being"):
+            stop_role[i] = "negator"  # "stop speeding" = do not speed
+            _in_scope(tokens, negated, i)
+        elif t == "stop" and prev in _POSSESSIVES:
+            stop_role[i] = "destination"
+        elif t in ("stop", "stops") and (prev in _DETERMINERS or prev == "bus"):
+            stop_role[i] = "noun"
+    v = np.zeros(N_CUES, dtype=np.float32)
+
+    def add(name: str) -> None:
+        v[_INDEX[name]] += 1.0
+
+    consumed = [False] * n  # words already counted as part of a phrase
+    for i in range(n):
+        for phrases, plain, flipped in (
+            (FAST_PHRASES, "fast", "neg_fast"),
+            (SLOW_PHRASES, "slow", "neg_slow"),
+        ):
+            for phrase in phrases:
+                k = len(phrase)
+                if not any(consumed[i : i + k]) and tuple(tokens[i : i + k]) == phrase:
+                    add(flipped if negated[i] else plain)
+                    consumed[i : i + k] = [True] * k
+    for i, t in enumerate(tokens):
+        if consumed[i]:
+            pass
+        elif t in FAST_WORDS:
+            add("neg_fast" if negated[i] else "fast")
+        elif t in SLOW_WORDS:
+            add("neg_slow" if negated[i] else "slow")
+        elif t in TOO_SLOW_WORDS:
+            add("too_slow")
+        elif t in TOO_FAST_WORDS:
+            add("too_fast")
+        elif t in CONTINUE_WORDS and negated[i]:
+            add("neg_continue")
+        if t in STOP_VERBS or t == "stops":
+            role = stop_role.get(i, "noun" if t == "stops" else "request")
+            if role in ("request", "noun", "destination"):
+                add(f"stop_{role}" if role != "request" else "stop_request")
+        for phrase in STOP_PHRASES:
+            if tuple(tokens[i : i + len(phrase)]) == phrase:
+                add("stop_request")
+    # "not one more meter", "not another inch": a negated quantity of further driving
+    if n >= 2 and tokens[0] in ("not", "no") and tokens[1] in ("one", "another", "a", "further"):
+        add("neg_continue")
+    return np.minimum(v, 2.0)
+
+
+def cue_features(texts: list[str]) -> NDArray[np.float32]:
+    """Cue counts for ``texts``, shape ``(len(texts), N_CUES)``."""
+    return np.stack([cue_vector(t) for t in texts]).astype(np.float32)

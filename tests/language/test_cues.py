@@ -1,0 +1,55 @@
+"""Lexical direction cues of the embedded LLM-1 (values worked out by hand)."""
+
+from __future__ import annotations
+
+import pytest
+
+from explaindrive.language.cues import CUE_NAMES, N_CUES, canonical, cue_features, cue_vector
+
+
+def cues(text: str) -> dict[str, float]:
+    """The non-zero cues of ``text`` by name."""
+    return {CUE_NAMES[i]: float(v) for i, v in enumerate(cue_vector(text)) if v}
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("Go a bit slower, please.", {"slow": 1.0}),
+        ("Go a bit faster, please.", {"fast": 1.0}),
+        ("Speed up.", {"fast": 1.0}),
+        ("Reduce the speed.", {"slow": 1.0}),  # "speed" alone is neutral
+        ("Don't go so fast.", {"neg_fast": 1.0}),
+        ("No need to hurry.", {"neg_fast": 1.0}),
+        ("This is too slow.", {"neg_slow": 1.0}),
+        ("Stop speeding.", {"neg_fast": 1.0}),  # "stop" before a gerund negates
+        ("Stop being so careful.", {"neg_slow": 1.0}),
+        ("Stop dawdling.", {"too_slow": 1.0}),
+        ("That stop was too abrupt.", {"stop_noun": 1.0, "too_fast": 1.0}),
+        ("This is my stop.", {"stop_destination": 1.0}),
+        ("Stop the car.", {"stop_request": 1.0}),
+        ("Pull over and let me out.", {"stop_request": 2.0}),
+        ("Don't go any further.", {"neg_continue": 1.0}),
+        ("Not one more block.", {"neg_continue": 1.0}),
+        # the negation ends at the clause break: "late" is a plain fast cue
+        ("Don't take it so easy, we're late.", {"neg_slow": 1.0, "fast": 1.0}),
+        ("Play some music.", {}),
+    ],
+)
+def test_cue_vectors(text: str, expected: dict[str, float]) -> None:
+    assert cues(text) == expected
+
+
+def test_typos_and_lookalikes() -> None:
+    assert canonical("slowr") == "slower" and canonical("fastr") == "faster"
+    assert canonical("slooow") == "slow" and canonical("hallt") == "halt"
+    # real words that resemble cue words are left alone
+    assert canonical("speed") == "speed" and canonical("mother") == "mother"
+    assert canonical("increase") == "increase"  # not "decrease"
+    assert cues("Increase the speed.") == {"fast": 1.0}
+
+
+def test_feature_shape_and_cap() -> None:
+    x = cue_features(["stop stop stop stop", "hello"])
+    assert x.shape == (2, N_CUES)
+    assert x[0, CUE_NAMES.index("stop_request")] == 2.0 and not x[1].any()
