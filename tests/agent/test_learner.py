@@ -52,6 +52,23 @@ def test_epsilon_greedy_batch() -> None:
     assert set(random.tolist()) == set(range(7))
 
 
+def test_shielded_actions_stay_safe() -> None:
+    learner = D3QNLearner(PAPER.replace(hidden_sizes=[4], shield=True))
+    with torch.no_grad():
+        for p in learner.q.parameters():
+            p.zero_()
+        learner.q.advantage.bias.copy_(torch.arange(7.0))  # greedy: +3 m/s
+    # 10 m/s towards a red light 30 m ahead: +2 and +3 cannot stop in time; +1 can
+    # (11 + 8 + 5 + 2 + 2 = 28 <= 30), so the shield keeps the best safe action, +1.
+    red = np.tile(np.array([0, 10.0, 13.89, 30.0, 10.0, 30.0, 2, 200.0], np.float32), (300, 1))
+    rng = np.random.default_rng(0)
+    assert set(learner.act(red, 0.0, rng).tolist()) == {4}
+    explored = learner.act(red, 1.0, rng)  # random actions, unsafe ones replaced
+    assert set(explored.tolist()) == {0, 1, 2, 3, 4}
+    free = np.array([[0, 5.0, 13.89, 200.0, 0.0, 200.0, 0, 200.0]], np.float32)
+    assert learner.act(free, 0.0, rng).tolist() == [6]
+
+
 def test_learning_rate_schedule() -> None:
     learner = D3QNLearner(PAPER.replace(lr=1e-3, lr_final=1e-4, lr_decay_steps=1000))
     assert learner.learning_rate(500) == pytest.approx(5.5e-4)

@@ -100,6 +100,10 @@ class TrainConfig:
     the env's cached warm-up states are reused; ``None`` gives every episode a fresh seed."""
     max_episode_steps: int | None = None
     """Env step limit per episode; ``None`` keeps the env's default."""
+    shield: bool = False
+    """Train through the kinematic safety shield (``agent/shield.py``): unsafe actions, chosen
+    greedily or by exploration, are replaced by the best-valued safe one before they reach the
+    env, and the replay stores the action executed. Off in the paper's setting."""
 
     checkpoint_every_episodes: int = 100
     """Completed episodes between checkpoints (one is also written at the end)."""

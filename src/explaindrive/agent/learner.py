@@ -11,6 +11,7 @@ import torch
 from explaindrive.agent.buffer import ReplayBatch
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.network import DuelingQNetwork
+from explaindrive.agent.shield import is_safe, shield
 from explaindrive.agent.targets import double_dqn_target, linear_schedule, td_loss
 from explaindrive.env.actions import N_ACTIONS
 
@@ -48,10 +49,16 @@ class D3QNLearner:
     def act(self, obs: np.ndarray, epsilon: float, rng: np.random.Generator) -> np.ndarray:
         """Epsilon-greedy actions for a batch of raw observations, in one forward pass."""
         obs = np.asarray(obs, dtype=np.float32).reshape(-1, self.q.state_dim)
-        greedy = self.q(torch.from_numpy(obs)).argmax(dim=-1).numpy()
+        q_values = self.q(torch.from_numpy(obs)).numpy()
+        greedy = q_values.argmax(axis=-1)
         explore = rng.random(len(obs)) < epsilon
         random_actions = rng.integers(0, N_ACTIONS, size=len(obs))
-        return np.where(explore, random_actions, greedy).astype(np.int64)
+        actions = np.where(explore, random_actions, greedy).astype(np.int64)
+        if self.config.shield:
+            for i, a in enumerate(actions):
+                if not is_safe(obs[i], int(a)):
+                    actions[i] = shield(obs[i], q_values[i]).action
+        return actions
 
     def update(self, batch: ReplayBatch, env_steps: int) -> dict[str, float]:
         """One gradient step on a minibatch; updates the target network when due.
