@@ -78,7 +78,7 @@ def ride(
     if interactive:
         typed = queue.Queue()
         _start_input_thread(typed, voice)
-    language = build_language(backend)
+    language = build_language(backend, speech=voice or any(ln.audio for ln in lines))
     session = RideSession(config, controller, language)
     if script is None and not interactive:
         console.print(f"default ride script: {default_script_path()}")

@@ -20,7 +20,9 @@ class RideConfig:
         stop_without_confirm: apply a STOP request as soon as it is understood.
         explanation_cooldown_s: an explanation for the same reason is repeated only
             after this long [s]; a new reason is explained at once.
-        interpret_deadline_s: wall-time budget of transcription + interpretation [s].
+        interpret_deadline_s: wall-time budget of interpreting a typed request [s].
+        audio_deadline_s: wall-time budget of transcribing and interpreting a spoken
+            request [s] (Whisper on a CPU needs about half the clip's length).
         explain_deadline_s: wall-time budget of one decision or explanation [s].
         realtime: pace the ride at one step per second.
         gui: show the ride in sumo-gui.
@@ -34,6 +36,7 @@ class RideConfig:
     stop_without_confirm: bool = False
     explanation_cooldown_s: float = 15.0
     interpret_deadline_s: float = 2.0
+    audio_deadline_s: float = 8.0
     explain_deadline_s: float = 1.0
     realtime: bool = False
     gui: bool = False
@@ -44,7 +47,12 @@ class RideConfig:
             raise ValueError(f"max_steps must be > 0, got {self.max_steps}")
         if not 0 <= self.seed < 2**31:
             raise ValueError(f"seed must be in [0, 2**31), got {self.seed}")
-        for name in ("explanation_cooldown_s", "interpret_deadline_s", "explain_deadline_s"):
+        for name in (
+            "explanation_cooldown_s",
+            "interpret_deadline_s",
+            "audio_deadline_s",
+            "explain_deadline_s",
+        ):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
         if self.backend not in ("embedded", "openai"):

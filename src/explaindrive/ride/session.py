@@ -197,7 +197,9 @@ class RideSession:
             "interpret",
             self._interpret,
             req,
-            deadline_s=self.config.interpret_deadline_s,
+            deadline_s=(
+                self.config.audio_deadline_s if audio else self.config.interpret_deadline_s
+            ),
             context={"request": req},
         )
         return req.id
