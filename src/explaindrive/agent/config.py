@@ -264,7 +264,7 @@ PAPER = TrainConfig()
 """The paper's values: 2x128, Adam 1e-3, MSE, 5M replay, batch 64, gamma 0.99, 11,000 episodes."""
 
 FAST = TrainConfig(
-    episodes=800,
+    episodes=1000,
     lr=1e-3,
     lr_final=1e-4,
     lr_decay_steps=300_000,
@@ -281,9 +281,12 @@ FAST = TrainConfig(
     eps_decay_steps=100_000,
     checkpoint_every_episodes=25,
     seed_pool=250,
+    shield=True,
 )
 """Tuned for wall time on 2 CPU cores: short linear exploration, lr decay, one update per
-two transitions, Polyak-averaged target, Huber loss with gradient clipping."""
+two transitions, Polyak-averaged target, Huber loss with gradient clipping, and training
+through the safety shield (no episode ends in a collision, so every episode teaches driving).
+The shipped policies were trained with this preset."""
 
 PRESETS: dict[str, TrainConfig] = {"paper": PAPER, "fast": FAST}
 
