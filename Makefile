@@ -26,7 +26,7 @@ system-deps:
 	fi
 
 demo: install
-	$(BIN)/explaindrive demo
+	$(BIN)/explaindrive ride --no-live
 
 test: dev-install system-deps
 	$(BIN)/python -m pytest
