@@ -26,7 +26,7 @@ system-deps:
 	fi
 
 demo: install
-	$(BIN)/explaindrive ride --no-live
+	$(BIN)/explaindrive ride
 
 test: dev-install system-deps
 	$(BIN)/python -m pytest
