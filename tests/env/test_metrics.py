@@ -71,7 +71,24 @@ def test_stop_latency_counts_steps_to_standstill():
         m.update(info(float(speed), cmd))
     r = m.result()
     assert r.stop_latencies == (3,)
+    assert r.stop_bound_misses == 0  # 3 steps <= ceil(9 / 3) + 2 = 5
     assert r.unfinished_stops == 1  # the second stop was lifted before standstill
+
+
+def test_slow_stop_misses_its_bound():
+    m = EpisodeMetrics()
+    # STOP at 6 m/s: bound ceil(6 / 3) + 2 = 4 steps; it takes 5
+    for speed, cmd in [
+        (6, "fast"),
+        (5, "stop"),
+        (4, "stop"),
+        (3, "stop"),
+        (2, "stop"),
+        (0, "stop"),
+    ]:
+        m.update(info(float(speed), cmd))
+    r = m.result()
+    assert r.stop_latencies == (5,) and r.stop_bound_misses == 1
     assert r.travel_time_s is None
 
 

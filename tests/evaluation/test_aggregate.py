@@ -23,7 +23,8 @@ def result(**kw: object) -> EpisodeResult:
     base: dict[str, object] = dict(
         steps=100, mean_speed_mps=5.0, avg_headway_s=None, avg_ttc_s=None, avg_jerk_mps3=0.0,
         collisions=0, red_light_runs=0, ped_violations=0, speeding_steps=0, stop_latencies=(),
-        unfinished_stops=0, distance_m=500.0, travel_time_s=None, total_reward=0.0,
+        unfinished_stops=0, stop_bound_misses=0, distance_m=500.0, travel_time_s=None,
+        total_reward=0.0,
     )  # fmt: skip
     base.update(kw)
     return EpisodeResult(**base)  # type: ignore[arg-type]
@@ -33,7 +34,7 @@ A = result(steps=100, mean_speed_mps=4.0, avg_headway_s=2.0, avg_ttc_s=3.0, avg_
            speeding_steps=10, stop_latencies=(2, 4), travel_time_s=100.0)  # fmt: skip
 B = result(steps=200, mean_speed_mps=6.0, avg_headway_s=None, avg_ttc_s=5.0, avg_jerk_mps3=0.4,
            collisions=1, red_light_runs=2, ped_violations=1, stop_latencies=(6,),
-           unfinished_stops=1)  # fmt: skip
+           unfinished_stops=1, stop_bound_misses=1)  # fmt: skip
 C = result(steps=300, mean_speed_mps=8.0, avg_headway_s=4.0, avg_ttc_s=None, avg_jerk_mps3=0.6,
            speeding_steps=20, travel_time_s=300.0)  # fmt: skip
 
@@ -51,7 +52,7 @@ def test_aggregate_by_hand() -> None:
     assert agg.collision_episodes == 1
     assert (agg.red_light_runs, agg.ped_violations) == (2, 1)
     assert agg.speeding_steps == 30 and agg.speeding_share == pytest.approx(30 / 600)
-    assert (agg.stops, agg.unfinished_stops) == (3, 1)
+    assert (agg.stops, agg.unfinished_stops, agg.stop_bound_misses) == (3, 1, 1)
     assert agg.stop_latency_mean_steps == pytest.approx(4.0)  # (2 + 4 + 6) / 3
     assert agg.stop_latency_max_steps == 6
     assert (agg.arrived, agg.travel_time_mean_s) == (2, pytest.approx(200.0))

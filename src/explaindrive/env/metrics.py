@@ -15,7 +15,9 @@ Definitions:
                  closes in on it and TTC < TTC_INTERACTION_S (10 s); larger
                  TTCs mean no conflict and would swamp the mean [s]
     avg jerk     mean of |jerk| over all steps [m/s^3]
-    stop latency for each switch to STOP: steps until the speed reaches 0
+    stop latency for each switch to STOP: steps until the speed reaches 0; a stop
+                 misses its bound when it takes more than ceil(v/3) + 2 steps, v
+                 being the speed when the command came
     travel time  seconds until the ego left the route (None if it did not)
 """
 
@@ -44,6 +46,7 @@ class EpisodeResult:
     speeding_steps: int
     stop_latencies: tuple[int, ...]
     unfinished_stops: int
+    stop_bound_misses: int
     distance_m: float
     travel_time_s: float | None
     total_reward: float
@@ -77,7 +80,9 @@ class EpisodeMetrics:
     ped_violations: int = 0
     speeding_steps: int = 0
     stop_latencies: list[int] = field(default_factory=list)
+    stop_bound_misses: int = 0
     _stop_open: int | None = None
+    _stop_bound: int = 0
     distance_m: float = 0.0
     time_s: float = 0.0
     arrived: bool = False
@@ -110,6 +115,8 @@ class EpisodeMetrics:
         # ``command`` is the command under which this step's action was taken.
         if command == "stop" and self._prev_command != "stop":
             self._stop_open = 0
+            speed_before = self.speeds[-2] if len(self.speeds) >= 2 else 0.0
+            self._stop_bound = stop_latency_bound(speed_before)
         if self._stop_open is not None:
             if command != "stop":
                 self._stop_open = None  # cancelled before standstill; counted as unfinished
@@ -118,6 +125,7 @@ class EpisodeMetrics:
                 self._stop_open += 1
                 if speed_mps <= 0.0:
                     self.stop_latencies.append(self._stop_open)
+                    self.stop_bound_misses += int(self._stop_open > self._stop_bound)
                     self._stop_open = None
         self._prev_command = command
 
@@ -137,6 +145,7 @@ class EpisodeMetrics:
             speeding_steps=self.speeding_steps,
             stop_latencies=tuple(self.stop_latencies),
             unfinished_stops=unfinished,
+            stop_bound_misses=self.stop_bound_misses,
             distance_m=self.distance_m,
             travel_time_s=self.time_s if self.arrived else None,
             total_reward=self.total_reward,

@@ -46,6 +46,7 @@ class Aggregate:
     unfinished_stops: int
     stop_latency_mean_steps: float | None
     stop_latency_max_steps: int | None
+    stop_bound_misses: int
     arrived: int
     travel_time_mean_s: float | None
 
@@ -105,6 +106,7 @@ def aggregate(results: Sequence[EpisodeResult]) -> Aggregate:
         unfinished_stops=sum(r.unfinished_stops for r in results),
         stop_latency_mean_steps=mean(float(x) for x in latencies),
         stop_latency_max_steps=max(latencies) if latencies else None,
+        stop_bound_misses=sum(r.stop_bound_misses for r in results),
         arrived=len(travel),
         travel_time_mean_s=mean(travel),
     )

@@ -94,7 +94,8 @@ def safety_table(summaries: Sequence[RunSummary]) -> str:
     """The measures the paper does not report: rule violations, stops and travel time."""
     header = [
         "policy", "episodes", "red-light runs", "ped-yield violations", "speeding steps (share)",
-        "stops done", "stop latency mean/max steps", "unfinished stops", "arrived",
+        "stops done", "stop latency mean/max steps", "over ceil(v/3)+2", "unfinished stops",
+        "arrived",
         "travel time s",
     ]  # fmt: skip
     rows = []
@@ -104,7 +105,8 @@ def safety_table(summaries: Sequence[RunSummary]) -> str:
             s.name, str(o.episodes), str(o.red_light_runs), str(o.ped_violations),
             f"{o.speeding_steps} ({100 * o.speeding_share:.1f}%)", str(o.stops),
             f"{fmt(o.stop_latency_mean_steps, 2)}/{fmt(o.stop_latency_max_steps)}",
-            str(o.unfinished_stops), f"{o.arrived}/{o.episodes}", fmt(o.travel_time_mean_s, 1),
+            str(o.stop_bound_misses), str(o.unfinished_stops), f"{o.arrived}/{o.episodes}",
+            fmt(o.travel_time_mean_s, 1),
         ])  # fmt: skip
     return _table(header, rows)
 
