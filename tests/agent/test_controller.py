@@ -90,3 +90,20 @@ def test_shipped_policy_paths() -> None:
     assert shipped_policy_path("comfort").parent.name == "policies"
     with pytest.raises(ValueError, match="no shipped policy"):
         shipped_policy_path("stop")
+
+
+def test_stop_guard_keeps_the_latency_bound(tmp_path: Path) -> None:
+    """A policy that brakes by only 1 m/s under STOP is pushed to stop within ceil(v/3) + 2."""
+    gentle = QPolicy.load(constant_policy(tmp_path, "gentle", 2))  # always -1 m/s
+    controller = MergedController(gentle, gentle, Command.STOP)
+    speed, changes = 6.0, []
+    while speed > 0:
+        obs = OBS.copy()
+        obs[1] = speed
+        change = controller.act(obs) - 3
+        changes.append(change)
+        speed = max(0.0, speed + change)
+    # bound ceil(6 / 3) + 2 = 4 steps: -1, -1, -1, then -3 from 3 m/s
+    assert changes == [-1, -1, -1, -3]
+    bare = MergedController(gentle, gentle, Command.STOP, use_shield=False)
+    assert bare.act(OBS) == 2  # without the shield the network decides alone

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from explaindrive.agent.shield import braking_distance, is_safe, shield
+from explaindrive.agent.shield import braking_distance, is_safe, shield, stop_in_time
 from explaindrive.env.actions import action_index
 
 
@@ -65,3 +65,11 @@ def test_shield_keeps_the_best_safe_action():
     assert red.action == action_index(1) and red.overridden
     wall = shield(obs(v=13, d_lead=1, dv=13, d_cross=1), q)
     assert wall.action == action_index(-3) and wall.overridden
+
+
+def test_stop_in_time():
+    # from 6 m/s with 4 steps left: -1 -> 5, then ceil(5 / 3) = 2 more: 3 <= 4
+    assert stop_in_time(6.0, action_index(-1), 4)
+    # with 1 step left only a standstill in this step will do
+    assert not stop_in_time(3.0, action_index(-1), 1)
+    assert stop_in_time(3.0, action_index(-3), 1)

@@ -20,7 +20,8 @@ from explaindrive.agent.checkpoint import CheckpointError, load_policy
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
-from explaindrive.env.state import CMD, STATE_DIM
+from explaindrive.env.metrics import stop_latency_bound
+from explaindrive.env.state import CMD, STATE_DIM, V_EGO
 
 log = logging.getLogger(__name__)
 
@@ -86,6 +87,7 @@ class MergedController:
         self.command = Command.FAST
         self.use_shield = use_shield
         self.overrides = 0
+        self._stop_steps_left: int | None = None  # under STOP: steps left to a standstill
         self.set_command(command)
 
     @classmethod
@@ -116,6 +118,8 @@ class MergedController:
         cmd = Command.parse(command)
         if cmd is not Command.STOP:
             self.active_agent = cmd
+        if cmd is not Command.STOP:
+            self._stop_steps_left = None
         if cmd is not self.command:
             log.debug("command %s -> %s (agent %s)", self.command.label, cmd.label,
                       self.active_agent.label)  # fmt: skip
@@ -137,6 +141,12 @@ class MergedController:
         x = self.observation(obs)
         if not self.use_shield:
             return self.policy.act(x)
-        decision = shield(x, self.policy.q_values(x))
+        steps_left = None
+        if self.command is Command.STOP:
+            if self._stop_steps_left is None:  # the first step under this STOP
+                self._stop_steps_left = stop_latency_bound(float(x[V_EGO]))
+            steps_left = self._stop_steps_left
+            self._stop_steps_left = max(1, self._stop_steps_left - 1)
+        decision = shield(x, self.policy.q_values(x), steps_left)
         self.overrides += int(decision.overridden)
         return decision.action

@@ -3,8 +3,9 @@
 Among the actions ordered by Q-value, the shield takes the first one after
 which the ego could still stop behind its leader (real or virtual) braking at
 -3 m/s per step, even if a real leader brakes at 9 m/s^2 (SUMO's emergency
-deceleration), and which does not
-exceed the posted limit. If no action qualifies, it brakes as hard as it can.
+deceleration), and which does not exceed the posted limit. If no action
+qualifies, it brakes as hard as it can. Under STOP it also keeps the stop within
+its latency bound (ceil(v/3) + 2 steps from the command).
 
 Red and yellow lights and occupied crossings are stop lines the ego must be able
 to stop before; a yellow light that even the hardest braking cannot stop for is
@@ -15,6 +16,7 @@ The shield is off during training; it is a runtime guard in the controller.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -103,12 +105,32 @@ def _is_stop_line(obs: NDArray[np.floating], gap: float) -> bool:
     return light or cross
 
 
+def stop_in_time(speed_mps: float, action: int, steps_left: int) -> bool:
+    """Whether, after ``action``, braking hardest still reaches 0 m/s within ``steps_left``
+    steps (this one included): the STOP latency guarantee."""
+    v_new = max(0.0, speed_mps + SPEED_CHANGES_MPS[action])
+    return 1 + math.ceil(v_new / MAX_BRAKE_MPS) <= steps_left
+
+
 def shield(
-    obs: NDArray[np.floating], q_values: Sequence[float] | NDArray[np.floating]
+    obs: NDArray[np.floating],
+    q_values: Sequence[float] | NDArray[np.floating],
+    stop_steps_left: int | None = None,
 ) -> ShieldDecision:
-    """The best-valued safe action for a raw observation."""
+    """The best-valued safe action for a raw observation.
+
+    Args:
+        obs: raw observation.
+        q_values: the policy's Q-values, one per action.
+        stop_steps_left: under STOP, the steps left to reach a standstill; actions that
+            would miss it are not allowed.
+    """
     order = np.argsort(-np.asarray(q_values, dtype=np.float64), kind="stable")
+    v = float(obs[S.V_EGO])
     for rank, a in enumerate(order):
-        if is_safe(obs, int(a)):
+        late = (
+            stop_steps_left is not None and v > 0 and not stop_in_time(v, int(a), stop_steps_left)
+        )
+        if not late and is_safe(obs, int(a)):
             return ShieldDecision(int(a), overridden=rank > 0)
     return ShieldDecision(action_index(-MAX_BRAKE_MPS), overridden=True)
