@@ -541,10 +541,16 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         return obs, leader, real
 
     def _ran_red_light(self, prev_pos: float, pos: float) -> bool:
-        ep = self._episode()
+        """The ego's front crossed a stop line during this step while the light was red.
+
+        SUMO switches signals at the start of a step and then moves the cars, so the
+        colour read after the step is the one that held while the ego crossed.
+        """
         for light in self.geometry.lights:
-            if prev_pos < light.stop_line_m <= pos:
-                return ep.light_state.get(light.tls_id) is S.LightState.RED
+            if prev_pos < light.stop_line_m <= pos and light.tls_id in self._tls_link:
+                states = self._conn.api.trafficlight.getSubscriptionResults(light.tls_id)
+                char = states[tc.TL_RED_YELLOW_GREEN_STATE][self._tls_link[light.tls_id]]
+                return S.LightState.from_sumo(char) is S.LightState.RED
         return False
 
     def _violated_crossing(self, prev_pos: float, pos: float) -> bool:
