@@ -457,15 +457,16 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         res = self._conn.api.edge.getSubscriptionResults(edge)
         return tuple(res.get(tc.LAST_STEP_PERSON_ID_LIST, ()))
 
-    def _crossing_occupied(self, crossing: RouteCrossing) -> bool:
+    def _crossing_occupied(self, crossing: RouteCrossing, on_it: bool) -> bool:
         """A pedestrian is on the crossing or, at a zebra, about to step onto it.
 
         At a signalized crossing pedestrians waiting on the kerb wait for their own
-        green, so only those already on the crossing count.
+        green, and once the ego is on the crossing (``on_it``) those on the kerb wait for
+        it, so then only pedestrians already on the crossing count.
         """
         if self._persons(crossing.crossing_edge):
             return True
-        if crossing.signalized:
+        if crossing.signalized or on_it:
             return False
         person = self._conn.api.person
         return any(
@@ -515,11 +516,13 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep.occupied = {}
         for crossing in self.geometry.crossings:
             ahead = crossing.stop_line_m - pos
-            if -EGO_LENGTH_M - 5.0 <= ahead < rng:
-                busy = self._crossing_occupied(crossing)
+            # Relevant from sensor range until the ego's front has left the junction: a car
+            # stopped on the crossing (e.g. by a STOP command) must not roll into pedestrians.
+            if crossing.stop_line_m - crossing.end_m <= ahead < rng:
+                busy = self._crossing_occupied(crossing, on_it=ahead < 0.0)
                 ep.occupied[crossing.crossing_edge] = bool(self._persons(crossing.crossing_edge))
-                if busy and ahead >= 0.0 and ahead < d_cross:
-                    d_cross = ahead
+                if busy:
+                    d_cross = min(d_cross, max(ahead, 0.0))
         if d_cross < rng and (leader is None or d_cross < leader.gap_m):
             leader = _Leader(d_cross, 0.0, 0.0, True)
 

@@ -31,6 +31,7 @@ class RouteCrossing:
     walkingareas: tuple[str, ...]  # walking areas from which pedestrians enter it
     stop_line_m: float  # [m] route position where the ego must stop for it
     signalized: bool
+    end_m: float  # [m] route position where the junction holding it ends
 
 
 @dataclass(frozen=True, slots=True)
@@ -152,6 +153,7 @@ def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGe
                 walkingareas=tuple(walk),
                 stop_line_m=end_of_edge[route_in[0]],
                 signalized=nodes[node_id].get("type") == "traffic_light",
+                end_m=starts[route_edges.index(route_in[0]) + 1],
             )
         )
     crossings.sort(key=lambda c: c.stop_line_m)
