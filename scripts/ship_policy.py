@@ -21,10 +21,19 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--run", type=Path, required=True, help="training run directory")
     parser.add_argument("--name", choices=("fast", "comfort"), required=True)
-    parser.add_argument("--evaluation", type=Path, action="append", default=[],
-                        help="evaluate --json output (repeatable)")
-    parser.add_argument("--command", action="append", default=[],
-                        help="the command that produced each evaluation file")
+    parser.add_argument(
+        "--evaluation",
+        type=Path,
+        action="append",
+        default=[],
+        help="evaluate --json output (repeatable)",
+    )
+    parser.add_argument(
+        "--command",
+        action="append",
+        default=[],
+        help="the command that produced each evaluation file",
+    )
     args = parser.parse_args()
     policy, card_file = args.run / "policy.pt", args.run / "policy.json"
     for path in (policy, card_file):
@@ -36,15 +45,17 @@ def main() -> None:
     for i, path in enumerate(args.evaluation):
         doc = json.loads(path.read_text())
         for run in doc["runs"]:
-            evaluations.append({
-                "command": args.command[i] if i < len(args.command) else None,
-                "run": run["name"],
-                "policy": run["policy"],
-                "schedule": run["schedule"],
-                "seeds": run["seeds"],
-                "traffic_levels": run["traffic_levels"],
-                "overall": run["aggregates"]["overall"],
-            })
+            evaluations.append(
+                {
+                    "command": args.command[i] if i < len(args.command) else None,
+                    "run": run["name"],
+                    "policy": run["policy"],
+                    "schedule": run["schedule"],
+                    "seeds": run["seeds"],
+                    "traffic_levels": run["traffic_levels"],
+                    "overall": run["aggregates"]["overall"],
+                }
+            )
     card["evaluation"] = evaluations or None
     POLICY_DIR.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(policy, POLICY_DIR / f"{args.name}.pt")
