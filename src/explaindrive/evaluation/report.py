@@ -367,12 +367,21 @@ def discussion(summaries: Mapping[str, RunSummary]) -> list[str]:
         "step counts (which scale with route length) and speeds are not expected to match; the "
         "trends over traffic levels and between the policies are the comparable part.",
         "- The paper does not define how TH and TTC are averaged. Ours average over steps with a "
-        "real leader in sensor range (TH) and over closing-in steps with TTC < "
+        "real leader in sensor range and the ego moving at >= 1 m/s (TH) and over closing-in "
+        "steps with TTC < "
         f"{TTC_INTERACTION_S:g} s (TTC), per episode, then over episodes; another convention "
         "moves these columns substantially.",
         "- Training budgets are listed under Policies (the paper trains 11,000 episodes with a "
         "5M replay buffer), and D3QN results vary between training seeds.",
         "- The SUMO baselines drive with SUMO's own safety model and are not in the paper; they "
-        "are a reference for what the scenario allows, not a reproduction target.",
+        "are a reference for what the scenario allows, not a reproduction target. Their "
+        "pedestrian-yield violations are passes while a pedestrian is still on the far half of "
+        "the crossing: SUMO lets a car through then, this project's rule (any pedestrian on the "
+        "crossing) does not.",
+        "- Our agents drive through the merged controller's kinematic safety shield "
+        "(`agent/shield.py`, `docs/agent.md`), which the paper does not have; "
+        "`explaindrive evaluate fast --no-shield` measures the bare networks. Our mean headways "
+        "are long partly because the shield keeps a stopping distance behind a leader that "
+        "might brake at 9 m/s^2.",
     ]
     return out
