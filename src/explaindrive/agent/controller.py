@@ -40,6 +40,11 @@ def shipped_policy_path(name: str) -> Path:
     return Path(str(root))
 
 
+def shipped_training_log(name: str) -> Path:
+    """Per-episode training log (``episodes.csv``) of a shipped policy."""
+    return shipped_policy_path(name).with_name(f"{name}_episodes.csv")
+
+
 @dataclass
 class QPolicy:
     """A greedy policy over a trained Q-network; takes raw observations."""

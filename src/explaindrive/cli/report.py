@@ -43,9 +43,13 @@ def report_command(
         typer.Option("--shield/--no-shield", help="Agents act through the safety shield."),
     ] = True,
     runs_dir: Annotated[
-        Path,
-        typer.Option("--runs", help="Training runs (<dir>/fast, <dir>/comfort) for the curves."),
-    ] = Path("runs"),
+        Path | None,
+        typer.Option(
+            "--runs",
+            help="Training runs (<dir>/fast, <dir>/comfort) for the curves "
+            "(default: the shipped policies' training logs).",
+        ),
+    ] = None,
     json_file: Annotated[
         Path | None, typer.Option("--json", help="Also write every episode and aggregate here.")
     ] = None,
@@ -81,8 +85,12 @@ def report_command(
     n = sum(len(run.episodes) for run in plan.runs)
     err_console.print(f"report: {len(plan.runs)} runs, {n} episodes")
     command_line = "explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    from explaindrive.agent.controller import shipped_training_log
+
     training = {
-        name: runs_dir / name / "episodes.csv" for name in names if name in ("fast", "comfort")
+        name: (runs_dir / name / "episodes.csv" if runs_dir else shipped_training_log(name))
+        for name in names
+        if name in ("fast", "comfort")
     }
     try:
         with progress_bar() as bar:
