@@ -50,20 +50,9 @@ STATE_HIGH = np.array(
     ],
     dtype=np.float32,
 )
-# Scales used by the optional normalisation: each component divided by its scale lies in [-1, 1].
-STATE_SCALE = np.array(
-    [
-        2.0,
-        MAX_SPEED_MPS,
-        MAX_SPEED_MPS,
-        SENSOR_RANGE_M,
-        MAX_SPEED_MPS,
-        SENSOR_RANGE_M,
-        2.0,
-        SENSOR_RANGE_M,
-    ],
-    dtype=np.float32,
-)
+# Scales of the optional normalisation: the largest magnitude of each component, so that
+# every normalised component lies in [-1, 1].
+STATE_SCALE = np.maximum(np.abs(STATE_LOW), np.abs(STATE_HIGH)).astype(np.float32)
 
 
 class LightState(IntEnum):
