@@ -8,15 +8,19 @@ STEP_LENGTH_S = 1.0  # [s] decision step = SUMO step
 IDLE_ACTION = SPEED_CHANGES_MPS.index(0)
 
 
-def speed_change(action: int) -> int:
-    """Speed change [m/s] of a discrete action index.
+def speed_change(action: object) -> int:
+    """Speed change [m/s] of a discrete action index (an int or a numpy integer).
 
     Raises:
-        ValueError: if ``action`` is not in ``range(N_ACTIONS)``.
+        ValueError: if ``action`` is not an integer in ``range(N_ACTIONS)``.
     """
-    if isinstance(action, bool) or not 0 <= int(action) < N_ACTIONS or int(action) != action:
+    try:
+        index = int(action)  # type: ignore[call-overload]
+    except (TypeError, ValueError):
+        index = -1
+    if isinstance(action, bool) or index != action or not 0 <= index < N_ACTIONS:
         raise ValueError(f"action {action!r} is outside the action space Discrete({N_ACTIONS})")
-    return SPEED_CHANGES_MPS[int(action)]
+    return SPEED_CHANGES_MPS[index]
 
 
 def action_index(change_mps: int) -> int:

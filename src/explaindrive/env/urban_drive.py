@@ -7,6 +7,7 @@ pedestrian-yield and speed-limit violations can happen and are counted.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import os
@@ -108,7 +109,11 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         if render_mode not in (None, "human"):
             raise ValueError(f"render_mode must be None or 'human', got {render_mode!r}")
         if isinstance(config, EnvConfig):
-            cfg = EnvConfig.from_mapping({**_asdict(config), **overrides}) if overrides else config
+            cfg = (
+                EnvConfig.from_mapping({**dataclasses.asdict(config), **overrides})
+                if overrides
+                else config
+            )
         else:
             cfg = EnvConfig.from_mapping({**dict(config or {}), **overrides})
         self.config = cfg
@@ -213,11 +218,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep = self._episode()
         if ep.done:
             raise RuntimeError("the episode is over; call reset() before step()")
-        change = (
-            speed_change(int(action))
-            if isinstance(action, int | np.integer)
-            else speed_change(action)
-        )
+        change = speed_change(action)
         api = self._conn.api
         cmd = ep.command
         prev_obs = self._last_obs
@@ -566,9 +567,3 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def _output(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         return S.normalize(obs) if self.config.normalize_obs else obs.copy()
-
-
-def _asdict(cfg: EnvConfig) -> dict[str, Any]:
-    import dataclasses
-
-    return {f.name: getattr(cfg, f.name) for f in dataclasses.fields(cfg)}
