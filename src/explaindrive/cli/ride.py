@@ -6,6 +6,7 @@ import queue
 import sys
 import threading
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.console import Console
@@ -14,6 +15,10 @@ from rich.live import Live
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.runner import AUDIO_PREFIX
 from explaindrive.ride.script import ScriptError, default_script_path, load_script
+
+if TYPE_CHECKING:
+    from explaindrive.ride.runner import RideOutputs
+    from explaindrive.ride.session import RideSession
 
 console = Console()
 
@@ -119,11 +124,7 @@ def _start_input_thread(typed: queue.Queue[str], voice: bool) -> None:
     threading.Thread(target=read, daemon=True, name="passenger-input").start()
 
 
-def _print_summary(session: object, outputs: object) -> None:
-    from explaindrive.ride.runner import RideOutputs
-    from explaindrive.ride.session import RideSession
-
-    assert isinstance(session, RideSession) and isinstance(outputs, RideOutputs)
+def _print_summary(session: RideSession, outputs: RideOutputs) -> None:
     m = session.metrics.result()
     c = session.counts
     console.print(
