@@ -116,3 +116,17 @@ def test_step_after_the_end_is_refused(tmp_path):
     run_ride(session, [], tmp_path)
     with pytest.raises(RuntimeError, match="not running"):
         session.step()
+
+
+def test_typed_yes_waits_for_its_question(tmp_path):
+    """Interactive input: a 'yes' typed before the question arrives answers it."""
+    import queue
+
+    typed: queue.Queue[str] = queue.Queue()
+    typed.put("stop please")
+    typed.put("yes")
+    session = make_session(max_steps=10)
+    run_ride(session, [], tmp_path, typed=typed)
+    assert [e["to"] for e in events(session, "confirmed")] == ["stop"]
+    assert session.counts.requests == 1  # "yes" was not taken for a new request
+    assert session.records[-1].command == "stop"

@@ -53,6 +53,10 @@ class LanguageLane:
         """Tasks submitted and not yet collected."""
         return len(self._pending)
 
+    def pending_kind(self, kind: str) -> bool:
+        """Whether a task of ``kind`` is pending."""
+        return any(t.kind == kind for t in self._pending)
+
     def submit(
         self,
         kind: str,

@@ -78,6 +78,7 @@ def run_ride(
     out_dir.mkdir(parents=True, exist_ok=True)
     outputs = RideOutputs(out_dir / "events.jsonl", out_dir / "summary.json", out_dir / "ride.png")
     todo = deque(lines)
+    held: list[str] = []  # typed answers waiting for their question
     written = 0
     session.start()
     try:
@@ -90,7 +91,7 @@ def run_ride(
                         session.say_audio(line.audio, confirm=line.confirm)
                     else:
                         session.say(line.say or "", confirm=line.confirm)
-                _drain_typed(session, typed)
+                _drain_typed(session, typed, held)
                 rec = session.step()
                 if on_step is not None:
                     on_step(rec)
@@ -114,21 +115,32 @@ def run_ride(
     return outputs
 
 
-def _drain_typed(session: RideSession, typed: queue.Queue[str] | None) -> None:
+def _drain_typed(
+    session: RideSession, typed: queue.Queue[str] | None, held: list[str] | None = None
+) -> None:
+    """Hand typed lines to the session; a yes/no typed while a request is still being
+    interpreted waits (in ``held``) for its question instead of becoming a new request."""
     if typed is None:
         return
+    lines = list(held or [])
+    if held is not None:
+        held.clear()
     while True:
         try:
-            text = typed.get_nowait().strip()
+            lines.append(typed.get_nowait())
         except queue.Empty:
-            return
+            break
+    for raw in lines:
+        text = raw.strip()
         if not text:
             continue
         if text.startswith(AUDIO_PREFIX):
             session.say_audio(Path(text[len(AUDIO_PREFIX) :]))
             continue
-        answer = parse_confirmation_answer(text) if session.pending_confirmation else None
-        if answer is not None:
+        answer = parse_confirmation_answer(text)
+        if answer is not None and session.pending_confirmation is not None:
             session.answer(answer)
+        elif answer is not None and session.interpreting and held is not None:
+            held.append(raw)
         else:
             session.say(text)

@@ -164,6 +164,11 @@ class RideSession:
         return float(len(self.records))
 
     @property
+    def interpreting(self) -> bool:
+        """Whether a passenger request is still being transcribed or interpreted."""
+        return self.lane.pending_kind("interpret")
+
+    @property
     def command(self) -> Command:
         """The confirmed command the car follows."""
         return self.controller.command
