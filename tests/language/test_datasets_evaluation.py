@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections import Counter
+from difflib import SequenceMatcher
 
 import pytest
 
@@ -11,6 +12,7 @@ from explaindrive.language.backends.embedded import RuleDecider, TemplateExplain
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
+    DEV2_CSV,
     DEV_CSV,
     TEST_CSV,
     TRAIN_CSV,
@@ -20,14 +22,22 @@ from explaindrive.language.datasets import (
 )
 from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
 
+NEAR_COPY = 0.8  # character similarity (difflib ratio) from which a text counts as a near-copy
 
-def test_corpus_sizes_and_dev_split() -> None:
-    train, dev = load_commands(data_path(TRAIN_CSV)), load_commands(data_path(DEV_CSV))
+
+@pytest.mark.parametrize("dev_csv", [DEV_CSV, DEV2_CSV])
+def test_corpus_sizes_and_dev_splits(dev_csv: str) -> None:
+    train, dev = load_commands(data_path(TRAIN_CSV)), load_commands(data_path(dev_csv))
     assert len(train) + len(dev) >= 400 and len(dev) >= 120
     assert {r.text.lower() for r in train}.isdisjoint({r.text.lower() for r in dev})
     counts = Counter(r.label for r in dev)
     assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
     assert {"direct", "indirect", "negation", "noise"} <= {r.kind for r in dev}
+
+
+def test_dev_splits_are_disjoint() -> None:
+    dev, dev2 = load_commands(data_path(DEV_CSV)), load_commands(data_path(DEV2_CSV))
+    assert {r.text.lower() for r in dev}.isdisjoint({r.text.lower() for r in dev2})
 
 
 def test_held_out_test_split() -> None:
@@ -36,12 +46,24 @@ def test_held_out_test_split() -> None:
     counts = Counter(r.label for r in test)
     assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
     assert {"direct", "indirect", "negation", "noise", "offtopic"} <= {r.kind for r in test}
-    seen = {r.text.lower() for name in (TRAIN_CSV, DEV_CSV) for r in load_commands(data_path(name))}
-    assert seen.isdisjoint({r.text.lower() for r in test})
+    seen = {
+        r.text.lower()
+        for name in (TRAIN_CSV, DEV_CSV, DEV2_CSV)
+        for r in load_commands(data_path(name))
+    }
+    near_copies = [
+        (t.text, s)
+        for t in test
+        for s in seen
+        if SequenceMatcher(None, t.text.lower(), s).quick_ratio() >= NEAR_COPY
+        and SequenceMatcher(None, t.text.lower(), s).ratio() >= NEAR_COPY
+    ]
+    assert near_copies == []
 
 
-def test_shipped_classifier_keeps_stop_recall_on_dev(interpreter) -> None:  # type: ignore[no-untyped-def]
-    rows = [r for r in load_commands(data_path(DEV_CSV)) if r.label == "stop"]
+@pytest.mark.parametrize("dev_csv", [DEV_CSV, DEV2_CSV])
+def test_shipped_classifier_keeps_stop_recall_on_dev(interpreter, dev_csv: str) -> None:  # type: ignore[no-untyped-def]
+    rows = [r for r in load_commands(data_path(dev_csv)) if r.label == "stop"]
     missed = [r.text for r in rows if interpreter.interpret(r.text).intent is not Command.STOP]
     assert missed == []
 
