@@ -33,11 +33,6 @@ def cues(text: str) -> dict[str, float]:
         ("Not one more block.", {"neg_continue": 1.0}),
         # the negation ends at the clause break: "late" is a plain fast cue
         ("Don't take it so easy, we're late.", {"neg_slow": 1.0, "fast": 1.0}),
-        # pace idioms: negated they flip ("don't floor it"); lingering is a complaint either way
-        ("Press on, please.", {"fast": 1.0}),
-        ("Don't floor it.", {"neg_fast": 1.0}),
-        ("Don't hang about.", {"too_slow": 1.0}),
-        ("We're ahead of schedule.", {"slow": 1.0}),
         ("Play some music.", {}),
     ],
 )

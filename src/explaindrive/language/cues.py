@@ -92,17 +92,6 @@ FAST_PHRASES: tuple[tuple[str, ...], ...] = (
     ("foot", "down"),
     ("more", "speed"),
     ("go", "go"),
-    # pace idioms: "press on", "floor it"; negated they ask for less ("don't floor it")
-    ("press", "on"),
-    ("push", "on"),
-    ("crack", "on"),
-    ("push", "it"),
-    ("floor", "it"),
-    ("gun", "it"),
-    ("put", "your", "foot"),
-    # too little time left
-    ("behind", "schedule"),
-    ("cutting", "it"),
 )
 SLOW_PHRASES: tuple[tuple[str, ...], ...] = (
     ("take", "your", "time"),
@@ -110,24 +99,6 @@ SLOW_PHRASES: tuple[tuple[str, ...], ...] = (
     ("ease", "up"),
     ("back", "off"),
     ("take", "it", "easy"),
-    # time to spare: "ahead of schedule", "plenty of time"
-    ("ahead", "of", "schedule"),
-    ("ahead", "of", "time"),
-    ("plenty", "of", "time"),
-    ("loads", "of", "time"),
-    ("lots", "of", "time"),
-    ("time", "to", "spare"),
-    ("time", "to", "kill"),
-    ("time", "in", "hand"),
-)
-# Idioms of lingering: a complaint about the pace whether negated or not ("don't hang about").
-TOO_SLOW_PHRASES: tuple[tuple[str, ...], ...] = (
-    ("hang", "about"),
-    ("hang", "around"),
-    ("hanging", "about"),
-    ("hanging", "around"),
-    ("taking", "ages"),
-    ("taking", "forever"),
 )
 _LEXICON: tuple[str, ...] = tuple(
     sorted(FAST_WORDS | SLOW_WORDS | TOO_SLOW_WORDS | TOO_FAST_WORDS | STOP_VERBS | {"stops"})
@@ -136,11 +107,11 @@ _TOKEN_RE = re.compile(r"[a-z']+|[.,!?;:]")
 _CLAUSE_BREAKS = frozenset(".,!?;:") | {"but", "and", "because"}
 
 CUE_NAMES: tuple[str, ...] = (
-    "fast",  # faster, hurry, late, "press on" ... not negated
-    "slow",  # slower, careful, gently, "ahead of schedule" ... not negated
+    "fast",  # faster, hurry, late ... not negated
+    "slow",  # slower, careful, gently ... not negated
     "neg_fast",  # "don't go so fast", "no need to hurry", "stop speeding", "too fast"
     "neg_slow",  # "don't be so careful", "too slow", "stop being so slow"
-    "too_slow",  # "crawling", "dawdling", "like a snail", "don't hang about"
+    "too_slow",  # "crawling", "dawdling", "like a snail"
     "too_fast",  # "reckless", "abrupt", "slamming"
     "stop_request",  # "stop", "halt", "pull over", "let me out" used as a request
     "stop_noun",  # "that stop was too abrupt", "your stops"
@@ -216,7 +187,6 @@ def cue_vector(text: str) -> NDArray[np.float32]:
         for phrases, plain, flipped in (
             (FAST_PHRASES, "fast", "neg_fast"),
             (SLOW_PHRASES, "slow", "neg_slow"),
-            (TOO_SLOW_PHRASES, "too_slow", "too_slow"),
         ):
             for phrase in phrases:
                 k = len(phrase)

@@ -2,9 +2,8 @@
 word n-grams, direction cues), blended with a nearest-neighbour vote over the training
 requests' embeddings.
 
-Protocol: the hyper-parameters (:class:`Hyper`: C, n-gram and cue weights, blend) and the
-``none`` threshold are chosen on the development splits (``commands_dev.csv`` and
-``commands_dev2.csv``, pooled) by a model fitted on the training split only; the shipped
+Protocol: the hyper-parameters (:class:`Hyper`: C, n-gram and cue weights, blend) are
+chosen on the development split by a model fitted on the training split only; the shipped
 model is then refitted on training + development requests. The held-out test split is
 never read here.
 
@@ -32,7 +31,6 @@ from sklearn.model_selection import StratifiedKFold
 
 from explaindrive.language.datasets import (
     CLASSIFIER_NPZ,
-    DEV2_CSV,
     DEV_CSV,
     INTENT_LABELS,
     TRAIN_CSV,
@@ -76,7 +74,6 @@ SELECTION_GRID: dict[str, tuple[float, ...]] = {
     "ngram_weight": (1.0, 1.5),
     "cue_weight": (0.0, 0.5, 1.0, 2.0),
     "lr_weight": (0.35, 0.5, 0.75, 1.0),
-    "none_threshold": (0.0, 0.4, 0.5),
 }
 
 
@@ -222,7 +219,6 @@ def _classifier(
     spec: FeatureSpec,
     hyper: Hyper,
     stop_threshold: float = MAX_STOP_THRESHOLD,
-    none_threshold: float = 0.0,
 ) -> IntentClassifier:
     return IntentClassifier(
         model.coef_.astype(np.float64),
@@ -230,7 +226,7 @@ def _classifier(
         ref_embeddings=x[:, :dim].copy(),
         ref_labels=y.copy(),
         stop_threshold=stop_threshold,
-        none_threshold=none_threshold,
+        none_threshold=0.0,
         spec=spec,
         lr_weight=hyper.lr_weight,
     )
@@ -270,15 +266,13 @@ class Selection:
     dev_accuracy: float  # 4-class accuracy on dev (none included), train-only model
     dev_stop_threshold: float  # highest threshold keeping dev STOP recall at 1.0
     dev_false_stops: int
-    none_threshold: float = 0.0  # below this top probability a request gets no command
 
 
 def select(train: Encoded, dev: Encoded, grid: dict[str, tuple[float, ...]]) -> Selection:
     """Pick the hyper-parameters whose train-only model is most accurate on dev.
 
     For each candidate the STOP threshold is the highest one that keeps STOP recall on
-    dev at 1.0, and each ``none`` threshold of the grid is tried; ties go to fewer false
-    STOPs, then to the earlier candidate in the grid.
+    dev at 1.0; ties go to fewer false STOPs, then to the earlier candidate in the grid.
     """
     dim = train.emb.shape[1]
     best: tuple[float, int, Selection] | None = None
@@ -291,36 +285,27 @@ def select(train: Encoded, dev: Encoded, grid: dict[str, tuple[float, ...]]) -> 
             clf = _classifier(model, x_tr, train.y, dim, spec, hyper)
             p = clf.proba(x_dev)
             t = recall_stop_threshold(p[:, STOP], dev.y == STOP)
-            for nt in grid.get("none_threshold", (0.0,)):
-                pred = np.array([INTENT_LABELS.index(clf.decide(row, t, nt)) for row in p])
-                acc = float(np.mean(pred == dev.y))
-                false_stops = int(np.sum((pred == STOP) & (dev.y != STOP)))
-                log.info(
-                    "C=%g ngram=%g cue=%g lr=%g none=%g: dev accuracy %.3f, threshold %.2f, "
-                    "false STOPs %d",
-                    c,
-                    ngram_w,
-                    cue_w,
-                    lr_w,
-                    nt,
-                    acc,
-                    t,
-                    false_stops,
-                )
-                if best is None or (acc, -false_stops) > (best[0], best[1]):
-                    best = (acc, -false_stops, Selection(hyper, acc, t, false_stops, nt))
+            pred = np.array([INTENT_LABELS.index(clf.decide(row, t)) for row in p])
+            acc = float(np.mean(pred == dev.y))
+            false_stops = int(np.sum((pred == STOP) & (dev.y != STOP)))
+            log.info(
+                "C=%g ngram=%g cue=%g lr=%g: dev accuracy %.3f, threshold %.2f, false STOPs %d",
+                c,
+                ngram_w,
+                cue_w,
+                lr_w,
+                acc,
+                t,
+                false_stops,
+            )
+            if best is None or (acc, -false_stops) > (best[0], best[1]):
+                best = (acc, -false_stops, Selection(hyper, acc, t, false_stops))
     assert best is not None
     return best[2]
 
 
 def fit_final(
-    train: Encoded,
-    dev: Encoded,
-    hyper: Hyper,
-    *,
-    none_threshold: float = 0.0,
-    folds: int = 5,
-    seed: int = 0,
+    train: Encoded, dev: Encoded, hyper: Hyper, *, folds: int = 5, seed: int = 0
 ) -> IntentClassifier:
     """Fit on training + development requests; calibrate the STOP threshold out of fold.
 
@@ -340,7 +325,7 @@ def fit_final(
     t_cost = tune_stop_threshold(oof[:, STOP], y == STOP)
     t_dev = recall_stop_threshold(oof[from_dev, STOP], y[from_dev] == STOP)
     stop_t = min(t_cost, t_dev)
-    clf = _classifier(_fit(x, y, hyper.c), x, y, dim, spec, hyper, stop_t, none_threshold)
+    clf = _classifier(_fit(x, y, hyper.c), x, y, dim, spec, hyper, stop_t)
     pred = np.array([INTENT_LABELS.index(clf.decide(row)) for row in oof])
     log.info(
         "out-of-fold (train+dev) accuracy %.3f, STOP recall %.3f; stop threshold %.2f "
@@ -364,33 +349,25 @@ def train(
     tr, dev = Encoded.of(train_rows, encoder), Encoded.of(dev_rows, encoder)
     sel = select(tr, dev, grid or SELECTION_GRID)
     log.info(
-        "selected %s, none threshold %.2f: dev accuracy %.3f (train-only model), "
-        "dev STOP threshold %.2f, false STOPs %d",
+        "selected %s: dev accuracy %.3f (train-only model), dev STOP threshold %.2f, "
+        "false STOPs %d",
         sel.hyper,
-        sel.none_threshold,
         sel.dev_accuracy,
         sel.dev_stop_threshold,
         sel.dev_false_stops,
     )
-    return fit_final(tr, dev, sel.hyper, none_threshold=sel.none_threshold), sel
+    return fit_final(tr, dev, sel.hyper), sel
 
 
 def main(argv: list[str] | None = None) -> None:
     """Retrain the shipped classifier from the shipped training and development splits."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--train", type=Path, default=data_path(TRAIN_CSV))
-    parser.add_argument(
-        "--dev",
-        type=Path,
-        nargs="+",
-        default=[data_path(DEV_CSV), data_path(DEV2_CSV)],
-        help="development splits (pooled for selection, STOP threshold and refit)",
-    )
+    parser.add_argument("--dev", type=Path, default=data_path(DEV_CSV))
     parser.add_argument("--out", type=Path, default=data_path(CLASSIFIER_NPZ))
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    train_rows = load_commands(args.train)
-    dev_rows = [row for path in args.dev for row in load_commands(path)]
+    train_rows, dev_rows = load_commands(args.train), load_commands(args.dev)
     clf, _ = train(train_rows, dev_rows, SentenceEncoder())
     clf.save(args.out)
     log.info("wrote %s (%d + %d examples)", args.out, len(train_rows), len(dev_rows))
