@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 from collections.abc import Sequence
 from datetime import UTC, datetime
 from importlib import metadata
@@ -36,6 +35,7 @@ from typing import Any
 from explaindrive.evaluation.aggregate import aggregate, aggregate_by_level
 from explaindrive.evaluation.paper import paper_row
 from explaindrive.evaluation.runner import EpisodeRecord
+from explaindrive.jsonsafe import finite
 
 SCHEMA_NAME = "explaindrive-evaluation"
 SCHEMA_VERSION = 1
@@ -43,17 +43,6 @@ SCHEMA_VERSION = 1
 
 def _unique(values: Sequence[Any]) -> list[Any]:
     return list(dict.fromkeys(values))
-
-
-def _finite(value: Any) -> Any:
-    """JSON has no inf/nan: map them to ``None`` recursively."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_finite(v) for v in value]
-    return value
 
 
 def episode_document(record: EpisodeRecord, include_trace: bool = True) -> dict[str, Any]:
@@ -110,7 +99,7 @@ def evaluation_document(runs: Sequence[dict[str, Any]]) -> dict[str, Any]:
         version = metadata.version("explaindrive")
     except metadata.PackageNotFoundError:
         version = "unknown"
-    return _finite(
+    return finite(
         {
             "schema": SCHEMA_NAME,
             "version": SCHEMA_VERSION,

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import logging
-import math
 import queue
 import time
 from collections import deque
@@ -13,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
+from explaindrive.jsonsafe import finite
 from explaindrive.language.intent import parse_confirmation_answer
 from explaindrive.ride.plot import plot_ride
 from explaindrive.ride.script import ScriptLine
@@ -34,26 +34,13 @@ class RideOutputs:
 
 
 def _json_default(value: Any) -> Any:
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
     if isinstance(value, Path):
         return str(value)
     raise TypeError(f"not JSON serialisable: {value!r}")
 
 
-def _clean(obj: Any) -> Any:
-    """Replace non-finite floats (inf TTC/headway) by None for strict JSON."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_clean(v) for v in obj]
-    return obj
-
-
 def _write(fh: IO[str], rec: StepRecord) -> None:
-    fh.write(json.dumps(_clean(rec.to_json()), default=_json_default) + "\n")
+    fh.write(json.dumps(finite(rec.to_json()), default=_json_default) + "\n")
     fh.flush()
 
 
@@ -106,7 +93,7 @@ def run_ride(
         session.close()
     summary = session.summary()
     summary["unused_script_lines"] = [line.model_dump(mode="json") for line in todo]
-    outputs.summary.write_text(json.dumps(_clean(summary), indent=2, default=_json_default))
+    outputs.summary.write_text(json.dumps(finite(summary), indent=2, default=_json_default))
     plot_ride(
         session.records,
         outputs.figure,

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import logging
-import math
 import queue
 import tempfile
 import threading
@@ -24,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from explaindrive.commands import Command
+from explaindrive.jsonsafe import finite
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession, StepRecord
 from explaindrive.web.models import StartRequest
@@ -64,17 +64,6 @@ class _Job:
     name: str
     args: tuple[Any, ...]
     future: cf.Future[Any] = field(default_factory=cf.Future)
-
-
-def _finite(obj: Any) -> Any:
-    """Replace non-finite floats by ``None`` so that frames are strict JSON."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_finite(v) for v in obj]
-    return obj
 
 
 class RideManager:
@@ -345,7 +334,7 @@ class RideManager:
                     {"t": session.records[index].t, "text": exp["text"], "factor": exp["factor"]}
                 )
         pending = session.pending_confirmation
-        return _finite(
+        return finite(
             {
                 "type": "frame",
                 "ride": self._ride,
