@@ -9,6 +9,16 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from explaindrive.cli._grid_options import (
+    ComfortPolicyOption,
+    FastPolicyOption,
+    MaxStepsOption,
+    RayAddressOption,
+    RayOption,
+    ShieldOption,
+    WorkersOption,
+    check_ray_target,
+)
 from explaindrive.evaluation.paper import PAPER_SEEDS, PAPER_TRAFFIC_LEVELS
 
 console = Console()
@@ -51,27 +61,13 @@ def evaluate_command(
     figures: Annotated[
         Path | None, typer.Option("--figures", help="Write PNG figures into this directory.")
     ] = None,
-    workers: Annotated[
-        int | None, typer.Option("--workers", min=1, help="Processes (default: one per CPU).")
-    ] = None,
-    ray: Annotated[bool, typer.Option("--ray", help="Run the episodes on a local Ray.")] = False,
-    ray_address: Annotated[
-        str | None, typer.Option("--ray-address", help="Run the episodes on this Ray cluster.")
-    ] = None,
-    max_steps: Annotated[
-        int, typer.Option("--max-steps", min=1, help="Step limit per episode [s].")
-    ] = 1000,
-    fast_policy: Annotated[
-        Path | None, typer.Option("--fast-policy", help="Fast policy file instead of the shipped.")
-    ] = None,
-    comfort_policy: Annotated[
-        Path | None,
-        typer.Option("--comfort-policy", help="Comfort policy file instead of the shipped."),
-    ] = None,
-    shield: Annotated[
-        bool,
-        typer.Option("--shield/--no-shield", help="Agents act through the safety shield."),
-    ] = True,
+    workers: WorkersOption = None,
+    ray: RayOption = False,
+    ray_address: RayAddressOption = None,
+    max_steps: MaxStepsOption = 1000,
+    fast_policy: FastPolicyOption = None,
+    comfort_policy: ComfortPolicyOption = None,
+    shield: ShieldOption = True,
     episodes: Annotated[
         bool, typer.Option("--episodes/--no-episodes", help="Also print one row per episode.")
     ] = True,
@@ -102,8 +98,8 @@ def evaluate_command(
     except SpecError as exc:
         err_console.print(f"[red]error:[/red] {exc}")
         raise typer.Exit(2) from None
-    if ray and ray_address:
-        err_console.print("[red]error:[/red] give --ray or --ray-address, not both")
+    if (problem := check_ray_target(ray, ray_address)) is not None:
+        err_console.print(f"[red]error:[/red] {problem}")
         raise typer.Exit(2)
 
     n = len(plan.episodes)

@@ -9,6 +9,16 @@ from typing import Annotated
 
 import typer
 
+from explaindrive.cli._grid_options import (
+    ComfortPolicyOption,
+    FastPolicyOption,
+    MaxStepsOption,
+    RayAddressOption,
+    RayOption,
+    ShieldOption,
+    WorkersOption,
+    check_ray_target,
+)
 from explaindrive.cli.evaluate import DEFAULT_TRAFFIC, err_console, progress_bar
 from explaindrive.evaluation.spec import POLICY_NAMES
 
@@ -31,17 +41,9 @@ def report_command(
     policies: Annotated[
         str, typer.Option("--policies", help="Subset of " + ",".join(POLICY_NAMES) + ".")
     ] = ",".join(POLICY_NAMES),
-    fast_policy: Annotated[
-        Path | None, typer.Option("--fast-policy", help="Fast policy file instead of the shipped.")
-    ] = None,
-    comfort_policy: Annotated[
-        Path | None,
-        typer.Option("--comfort-policy", help="Comfort policy file instead of the shipped."),
-    ] = None,
-    shield: Annotated[
-        bool,
-        typer.Option("--shield/--no-shield", help="Agents act through the safety shield."),
-    ] = True,
+    fast_policy: FastPolicyOption = None,
+    comfort_policy: ComfortPolicyOption = None,
+    shield: ShieldOption = True,
     runs_dir: Annotated[
         Path | None,
         typer.Option(
@@ -53,24 +55,19 @@ def report_command(
     json_file: Annotated[
         Path | None, typer.Option("--json", help="Also write every episode and aggregate here.")
     ] = None,
-    workers: Annotated[
-        int | None, typer.Option("--workers", min=1, help="Processes (default: one per CPU).")
-    ] = None,
-    ray: Annotated[bool, typer.Option("--ray", help="Run the episodes on a local Ray.")] = False,
-    ray_address: Annotated[
-        str | None, typer.Option("--ray-address", help="Run the episodes on this Ray cluster.")
-    ] = None,
-    max_steps: Annotated[
-        int, typer.Option("--max-steps", min=1, help="Step limit per episode [s].")
-    ] = 1000,
+    workers: WorkersOption = None,
+    ray: RayOption = False,
+    ray_address: RayAddressOption = None,
+    max_steps: MaxStepsOption = 1000,
 ) -> None:
     """Evaluate the policies and baselines and rewrite the results document and figures."""
     from explaindrive.agent.checkpoint import CheckpointError
+    from explaindrive.agent.controller import shipped_training_log
     from explaindrive.evaluation.report import parse_policy_list, plan_report, run_report
     from explaindrive.evaluation.spec import SpecError, parse_levels
 
-    if ray and ray_address:
-        err_console.print("[red]error:[/red] give --ray or --ray-address, not both")
+    if (problem := check_ray_target(ray, ray_address)) is not None:
+        err_console.print(f"[red]error:[/red] {problem}")
         raise typer.Exit(2)
     try:
         names = parse_policy_list(policies)
@@ -85,8 +82,6 @@ def report_command(
     n = sum(len(run.episodes) for run in plan.runs)
     err_console.print(f"report: {len(plan.runs)} runs, {n} episodes")
     command_line = "explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-    from explaindrive.agent.controller import shipped_training_log
-
     training = {
         name: (runs_dir / name / "episodes.csv" if runs_dir else shipped_training_log(name))
         for name in names
