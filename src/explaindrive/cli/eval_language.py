@@ -24,8 +24,6 @@ from explaindrive.language.datasets import (
     load_commands,
     load_decisions,
 )
-from explaindrive.language.evaluation import evaluate_decisions, evaluate_intents
-from explaindrive.language.stack import make_language_stack
 
 DEFAULT_COMMANDS = data_path(TEST_CSV)
 DEFAULT_DECISIONS = data_path(DECISIONS_JSONL)
@@ -47,9 +45,13 @@ def intents_command(
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
     try:
         rows = load_commands(data)
+        from explaindrive.language.stack import make_language_stack
+
         stack = make_language_stack(backend, load_config(config))
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
+    from explaindrive.language.evaluation import evaluate_intents
+
     report = evaluate_intents(stack.interpreter, rows)
     report.update(backend=stack.backend, data=str(data))
     table = Table(title=f"LLM-1 on {data.name} ({stack.backend})")
@@ -80,9 +82,13 @@ def decisions_command(
     """Trigger accuracy/precision/recall/F1, factor accuracy and grounding of LLM-2/LLM-3."""
     try:
         rows = load_decisions(data)
+        from explaindrive.language.stack import make_language_stack
+
         stack = make_language_stack(backend, load_config(config))
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
+    from explaindrive.language.evaluation import evaluate_decisions
+
     report = evaluate_decisions(stack.decider, stack.explainer, rows)
     report.update(backend=stack.backend, data=str(data))
     console.print(

@@ -15,7 +15,6 @@ from explaindrive.cli._language_common import (
     fail,
     load_config,
 )
-from explaindrive.language.stack import make_language_stack
 from explaindrive.language.summary import StateRecord, environment_summary
 
 
@@ -28,6 +27,8 @@ def explain_command(
     """Decide whether a step's action needs explaining and, if so, explain it."""
     try:
         record = StateRecord.load(case)
+        from explaindrive.language.stack import make_language_stack
+
         stack = make_language_stack(backend, load_config(config))
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))

@@ -16,7 +16,6 @@ from explaindrive.cli._language_common import (
     load_config,
 )
 from explaindrive.language.speech import AudioError
-from explaindrive.language.stack import make_language_stack
 
 
 def interpret_command(
@@ -30,6 +29,8 @@ def interpret_command(
     if (text is None) == (audio is None):
         fail("give either TEXT or --audio FILE")
     try:
+        from explaindrive.language.stack import make_language_stack
+
         stack = make_language_stack(backend, load_config(config))
     except ValueError as exc:
         fail(str(exc))

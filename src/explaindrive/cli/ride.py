@@ -13,8 +13,7 @@ from rich.console import Console
 from rich.live import Live
 
 from explaindrive.ride.config import RideConfig
-from explaindrive.ride.runner import AUDIO_PREFIX
-from explaindrive.ride.script import ScriptError, default_script_path, load_script
+from explaindrive.ride.script import AUDIO_PREFIX, ScriptError, default_script_path, load_script
 
 if TYPE_CHECKING:
     from explaindrive.ride.runner import RideOutputs

@@ -15,12 +15,11 @@ from typing import IO, Any
 from explaindrive.jsonsafe import finite
 from explaindrive.language.intent import parse_confirmation_answer
 from explaindrive.ride.plot import plot_ride
-from explaindrive.ride.script import ScriptLine
+from explaindrive.ride.script import AUDIO_PREFIX, ScriptLine
 from explaindrive.ride.session import RideSession, StepRecord
 
 log = logging.getLogger(__name__)
 
-AUDIO_PREFIX = "@audio:"  # a typed-queue item that names a recorded WAV file
 WRITE_LAG_STEPS = 3  # records are written once late language results can no longer change them
 
 

@@ -21,6 +21,8 @@ from typing import Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+AUDIO_PREFIX = "@audio:"  # a typed passenger line that names a recorded audio file
+
 
 class ScriptError(ValueError):
     """A ride script cannot be read or is invalid."""
