@@ -13,6 +13,7 @@ from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
     DEV2_CSV,
+    DEV3_CSV,
     DEV_CSV,
     TEST_CSV,
     TRAIN_CSV,
@@ -25,7 +26,7 @@ from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
 NEAR_COPY = 0.8  # character similarity (difflib ratio) from which a text counts as a near-copy
 
 
-@pytest.mark.parametrize("dev_csv", [DEV_CSV, DEV2_CSV])
+@pytest.mark.parametrize("dev_csv", [DEV_CSV, DEV2_CSV, DEV3_CSV])
 def test_corpus_sizes_and_dev_splits(dev_csv: str) -> None:
     train, dev = load_commands(data_path(TRAIN_CSV)), load_commands(data_path(dev_csv))
     assert len(train) + len(dev) >= 400 and len(dev) >= 120
@@ -36,19 +37,21 @@ def test_corpus_sizes_and_dev_splits(dev_csv: str) -> None:
 
 
 def test_dev_splits_are_disjoint() -> None:
-    dev, dev2 = load_commands(data_path(DEV_CSV)), load_commands(data_path(DEV2_CSV))
-    assert {r.text.lower() for r in dev}.isdisjoint({r.text.lower() for r in dev2})
+    splits = [{r.text.lower() for r in load_commands(data_path(n))} for n in (DEV_CSV, DEV2_CSV, DEV3_CSV)]
+    for i, a in enumerate(splits):
+        for b in splits[i + 1 :]:
+            assert a.isdisjoint(b)
 
 
 def test_held_out_test_split() -> None:
     test = load_commands(data_path(TEST_CSV))
-    assert len(test) >= 130
+    assert len(test) >= 150
     counts = Counter(r.label for r in test)
     assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
     assert {"direct", "indirect", "negation", "noise", "offtopic"} <= {r.kind for r in test}
     seen = {
         r.text.lower()
-        for name in (TRAIN_CSV, DEV_CSV, DEV2_CSV)
+        for name in (TRAIN_CSV, DEV_CSV, DEV2_CSV, DEV3_CSV)
         for r in load_commands(data_path(name))
     }
     near_copies = [
@@ -61,7 +64,7 @@ def test_held_out_test_split() -> None:
     assert near_copies == []
 
 
-@pytest.mark.parametrize("dev_csv", [DEV_CSV, DEV2_CSV])
+@pytest.mark.parametrize("dev_csv", [DEV_CSV, DEV2_CSV, DEV3_CSV])
 def test_shipped_classifier_keeps_stop_recall_on_dev(interpreter, dev_csv: str) -> None:  # type: ignore[no-untyped-def]
     rows = [r for r in load_commands(data_path(dev_csv)) if r.label == "stop"]
     missed = [r.text for r in rows if interpreter.interpret(r.text).intent is not Command.STOP]
