@@ -34,6 +34,18 @@ def cues(text: str) -> dict[str, float]:
         # the negation ends at the clause break: "late" is a plain fast cue
         ("Don't take it so easy, we're late.", {"neg_slow": 1.0, "fast": 1.0}),
         ("Play some music.", {}),
+        # idioms
+        ("What's the rush?", {"neg_fast": 1.0}),
+        ("Hold your horses, we have time.", {"slow": 1.0}),
+        ("Chop chop!", {"fast": 1.0}),
+        ("Don't floor it.", {"neg_fast": 1.0}),
+        ("This will do, thanks.", {"arrival": 1.0}),
+        ("Right here is fine.", {"arrival": 1.0}),  # one phrase, counted once
+        ("How far is it from here?", {}),
+        # chat spellings: "ez" is "easy", "to fast" is "too fast"
+        ("ez on the pedal plz", {"slow": 1.0}),
+        ("to quick man", {"neg_fast": 1.0}),
+        ("I want to fast tomorrow", {"fast": 1.0}),  # "to" before a verb stays "to"
     ],
 )
 def test_cue_vectors(text: str, expected: dict[str, float]) -> None:
@@ -47,6 +59,9 @@ def test_typos_and_lookalikes() -> None:
     assert canonical("speed") == "speed" and canonical("mother") == "mother"
     assert canonical("increase") == "increase"  # not "decrease"
     assert cues("Increase the speed.") == {"fast": 1.0}
+    # short common words are not read as the longer cue words they resemble
+    for word in ("slot", "waving", "later", "showing"):
+        assert canonical(word) == word
 
 
 def test_feature_shape_and_cap() -> None:

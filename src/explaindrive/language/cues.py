@@ -29,7 +29,8 @@ def _words(text: str) -> frozenset[str]:
 FAST_WORDS = _words(
     """fast faster fastest quick quicker quickly quicken hurry hurrying hurried rush
     rushing rushed accelerate accelerating acceleration race racing speeding
-    sooner asap urgent urgently late briskly brisk throttle zoom increase raise"""
+    sooner asap urgent urgently late briskly brisk throttle zoom increase raise
+    hustle pronto swift swiftly speedy speedier promptly"""
 )
 SLOW_WORDS = _words(
     """slow slower slowly slowing slowed careful carefully cautious cautiously gentle
@@ -40,17 +41,20 @@ SLOW_WORDS = _words(
 # Complaints about the pace: slowness words ask for more speed, recklessness words for less.
 TOO_SLOW_WORDS = _words(
     """crawl crawling crawls dawdle dawdling dawdles dilly dallying snail turtle creep
-    creeping crawling dragging drag poking lagging hesitating timid idling sluggish"""
+    creeping crawling dragging drag poking lagging hesitating timid idling sluggish
+    tortoise glacial glacier sloth funeral hearse pootling pootle lollygagging
+    lollygag faffing faff dithering dither tiptoe tiptoeing"""
 )
 TOO_FAST_WORDS = _words(
     """reckless recklessly maniac aggressive aggressively swerving swerve tailgating
     abrupt abruptly harsh harshly jerky jerking sudden suddenly rough roughly bumpy
-    slamming slam stomping tearing"""
+    slamming slam stomping tearing hurtle hurtling hurtled weaving weave zigzagging
+    racetrack speedway daredevil kamikaze lurching lurch jolting jolt"""
 )
 # Requests to stop the trip, and words of continuing (negated: "no further").
 STOP_VERBS = _words("stop halt park stopping")
 # Common words that look like cue words with a typo but are not ("speed" is neutral).
-_NOT_TYPOS = _words("speed speeds sped")
+_NOT_TYPOS = _words("speed speeds sped waving wave slot slots later showing")
 STOP_PHRASES: tuple[tuple[str, ...], ...] = (
     ("pull", "over"),
     ("pull", "up"),
@@ -62,6 +66,32 @@ STOP_PHRASES: tuple[tuple[str, ...], ...] = (
     ("get", "out"),
     ("get", "off"),
     ("lemme",),
+    ("hop", "out"),
+    ("jump", "out"),
+    ("park", "it"),
+)
+# Arrival: the passenger signals that the car is where they want to get out.
+ARRIVAL_PHRASES: tuple[tuple[str, ...], ...] = (
+    ("we're", "here"),
+    ("we", "are", "here"),
+    ("we've", "arrived"),
+    ("we", "have", "arrived"),
+    ("this", "will", "do"),
+    ("this'll", "do"),
+    ("that'll", "do"),
+    ("here", "is", "fine"),
+    ("here's", "fine"),
+    ("here", "is", "good"),
+    ("here's", "good"),
+    ("here", "works"),
+    ("right", "here"),
+    ("just", "here"),
+    ("this", "is", "it"),
+    ("that's", "us"),
+    ("this", "is", "us"),
+    ("on", "foot"),
+    ("walk", "from", "here"),
+    ("drop", "off"),
 )
 CONTINUE_WORDS = _words("further farther continue continuing anymore another beyond past")
 NEGATORS = _words(
@@ -92,6 +122,25 @@ FAST_PHRASES: tuple[tuple[str, ...], ...] = (
     ("foot", "down"),
     ("more", "speed"),
     ("go", "go"),
+    ("chop", "chop"),
+    ("wriggle", "on"),
+    ("shift", "on"),
+    ("make", "tracks"),
+    ("pedal", "to", "the", "metal"),
+    ("floor", "it"),
+    ("on", "the", "gas"),
+    ("hit", "the", "gas"),
+    ("gun", "it"),
+    ("get", "cracking"),
+    ("shake", "a", "leg"),
+    ("on", "the", "double"),
+    ("hop", "to", "it"),
+    ("any", "day", "now"),
+    ("got", "all", "day"),
+    ("open", "her", "up"),
+    ("put", "your", "foot"),
+    ("right", "foot"),
+    ("push", "it"),
 )
 SLOW_PHRASES: tuple[tuple[str, ...], ...] = (
     ("take", "your", "time"),
@@ -99,6 +148,27 @@ SLOW_PHRASES: tuple[tuple[str, ...], ...] = (
     ("ease", "up"),
     ("back", "off"),
     ("take", "it", "easy"),
+    ("rein", "it", "in"),
+    ("rein", "in"),
+    ("hold", "your", "horses"),
+    ("cool", "it"),
+    ("tone", "it", "down"),
+    ("dial", "it", "back"),
+    ("dial", "back"),
+    ("dial", "the", "speed", "back"),
+    ("down", "a", "notch"),
+    ("chill", "out"),
+    ("steady", "on"),
+)
+# Questions that call the pace needless: "what's the rush?" asks for less speed.
+NEEDLESS_PACE_PHRASES: tuple[tuple[str, ...], ...] = (
+    ("what's", "the", "rush"),
+    ("what's", "the", "hurry"),
+    ("why", "the", "rush"),
+    ("why", "the", "hurry"),
+    ("where's", "the", "fire"),
+    ("no", "rush"),
+    ("no", "hurry"),
 )
 _LEXICON: tuple[str, ...] = tuple(
     sorted(FAST_WORDS | SLOW_WORDS | TOO_SLOW_WORDS | TOO_FAST_WORDS | STOP_VERBS | {"stops"})
@@ -117,6 +187,7 @@ CUE_NAMES: tuple[str, ...] = (
     "stop_noun",  # "that stop was too abrupt", "your stops"
     "stop_destination",  # "this is my stop"
     "neg_continue",  # "no further", "don't continue", "not another block"
+    "arrival",  # "we're here", "this will do", "right here is fine"
 )
 N_CUES = len(CUE_NAMES)
 _INDEX = {name: i for i, name in enumerate(CUE_NAMES)}
@@ -127,6 +198,14 @@ def tokenize(text: str) -> list[str]:
     return _TOKEN_RE.findall(text.lower().replace("\u2019", "'"))
 
 
+# Chat spellings of cue words, too short for the typo matcher.
+SLANG = {"ez": "easy", "ezy": "easy", "fst": "fast", "slw": "slow", "qck": "quick"}
+# "to fast" for "too fast": "to" before one of these, then the end of the clause or a
+# form of address, is the intensifier "too".
+_TOO_ADJECTIVES = _words("fast quick quickly slow slowly rough harsh jerky aggressive")
+_ADDRESS = _words("man mate dude bro pal buddy please pls plz")
+
+
 @lru_cache(maxsize=4096)
 def canonical(token: str) -> str:
     """The lexicon word ``token`` spells (allowing a typo), else ``token``.
@@ -134,6 +213,8 @@ def canonical(token: str) -> str:
     Repeated letters are squeezed first ("slooow" -> "slow"); tokens shorter than four
     letters must match exactly, and a typo never changes the first letter.
     """
+    if token in SLANG:
+        return SLANG[token]
     if token in _LEXICON or token in _NOT_TYPOS or len(token) < 4:
         return token
     squeezed = re.sub(r"(.)\1{2,}", r"\1", token)
@@ -163,6 +244,14 @@ def cue_vector(text: str) -> NDArray[np.float32]:
     raw = tokenize(text)
     tokens = [canonical(t) for t in raw]
     n = len(tokens)
+    for i in range(n - 1):
+        after = tokens[i + 2] if i + 2 < n else "."
+        if (
+            tokens[i] == "to"
+            and tokens[i + 1] in _TOO_ADJECTIVES
+            and (after in _CLAUSE_BREAKS or after in _ADDRESS)
+        ):
+            tokens[i] = "too"
     negated = [False] * n
     stop_role: dict[int, str] = {}
     for i, t in enumerate(tokens):
@@ -185,8 +274,10 @@ def cue_vector(text: str) -> NDArray[np.float32]:
     consumed = [False] * n  # words already counted as part of a phrase
     for i in range(n):
         for phrases, plain, flipped in (
+            (NEEDLESS_PACE_PHRASES, "neg_fast", "neg_fast"),
             (FAST_PHRASES, "fast", "neg_fast"),
             (SLOW_PHRASES, "slow", "neg_slow"),
+            (ARRIVAL_PHRASES, "arrival", "arrival"),
         ):
             for phrase in phrases:
                 k = len(phrase)

@@ -28,6 +28,7 @@ log = logging.getLogger(__name__)
 HASH_FEATURES = 2**12
 NGRAM_WEIGHT = 1.5  # scale of the (l2-normalised) n-gram block next to the unit embedding
 CUE_WEIGHT = 1.0  # scale of the cue counts
+ENCODE_BATCH = 64  # sentences per forward pass
 
 
 def default_embedding_model_dir() -> Path:
@@ -80,19 +81,37 @@ class SentenceEncoder:
             self._model = SentenceTransformer(str(path), device="cpu", local_files_only=True)
 
     def encode(self, texts: list[str]) -> NDArray[np.float32]:
-        """Embeddings of ``texts``, shape ``(len(texts), dim)``, each of unit norm."""
+        """Embeddings of ``texts``, shape ``(len(texts), dim)``, each of unit norm.
+
+        Runs the model's own tokenizer and forward pass under ``torch.inference_mode``
+        (the same embeddings as ``SentenceTransformer.encode``, without its per-call
+        bookkeeping, which dominates for the single short sentences of a ride).
+        """
         self.load()
         import torch
 
+        model = self._model
+        prepare = getattr(model, "preprocess", None) or model.tokenize
         previous = torch.get_num_threads()
-        torch.set_num_threads(self.threads)
+        if previous != self.threads:
+            torch.set_num_threads(self.threads)
         try:
-            out = self._model.encode(
-                texts, batch_size=64, normalize_embeddings=True, show_progress_bar=False
-            )
+            with torch.inference_mode():
+                parts = [
+                    torch.nn.functional.normalize(
+                        model(prepare(texts[i : i + ENCODE_BATCH]))["sentence_embedding"], dim=-1
+                    ).numpy()
+                    for i in range(0, len(texts), ENCODE_BATCH)
+                ]
         finally:
-            torch.set_num_threads(previous)
-        return np.asarray(out, dtype=np.float32)
+            if previous != self.threads:
+                torch.set_num_threads(previous)
+        if not parts:
+            dim = getattr(model, "get_embedding_dimension", None) or (
+                model.get_sentence_embedding_dimension
+            )
+            return np.zeros((0, dim()), dtype=np.float32)
+        return np.vstack(parts).astype(np.float32, copy=False)
 
 
 _hasher = HashingVectorizer(

@@ -3,15 +3,14 @@ word n-grams, direction cues), blended with a nearest-neighbour vote over the tr
 requests' embeddings.
 
 Protocol: the hyper-parameters (:class:`Hyper`: C, n-gram and cue weights, blend) are
-chosen on the development split by a model fitted on the training split only; the shipped
-model is then refitted on training + development requests. The held-out test split is
-never read here.
+chosen on the development splits, each held out in turn from a model fitted on the
+training requests and the other development splits; the shipped model is then refitted
+on all of them. The held-out test split is never read here.
 
 STOP is safety-critical: it wins whenever its probability reaches ``stop_threshold``. The
 threshold minimises a cost in which a missed STOP counts ``STOP_MISS_COST`` times a false
-STOP on out-of-fold probabilities of training + development requests, capped so that every
-development STOP request (out of fold) still reaches it. Retrain and re-ship the weights
-with::
+STOP, on the pooled held-out probabilities of the development requests. Retrain and
+re-ship the weights with::
 
     python -m explaindrive.language.intent_classifier
 """
@@ -27,11 +26,10 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 from sklearn.linear_model import LogisticRegression
-from sklearn.model_selection import StratifiedKFold
 
 from explaindrive.language.datasets import (
     CLASSIFIER_NPZ,
-    DEV_CSV,
+    DEV_SPLITS,
     INTENT_LABELS,
     TRAIN_CSV,
     CommandExample,
@@ -72,7 +70,7 @@ class Hyper:
 SELECTION_GRID: dict[str, tuple[float, ...]] = {
     "c": (10.0, 100.0),
     "ngram_weight": (1.0, 1.5),
-    "cue_weight": (0.0, 0.5, 1.0, 2.0),
+    "cue_weight": (0.0, 1.0, 2.0, 3.0),
     "lr_weight": (0.35, 0.5, 0.75, 1.0),
 }
 
@@ -232,14 +230,6 @@ def _classifier(
     )
 
 
-def recall_stop_threshold(p_stop: NDArray[np.floating], is_stop: NDArray[np.bool_]) -> float:
-    """Highest threshold on the 0.01 grid at which every STOP row still reaches it."""
-    if not is_stop.any():
-        return MAX_STOP_THRESHOLD
-    t = np.floor(float(np.min(p_stop[is_stop])) * 100.0) / 100.0
-    return float(np.clip(t, MIN_STOP_THRESHOLD, MAX_STOP_THRESHOLD))
-
-
 @dataclass(frozen=True, slots=True)
 class Encoded:
     """Labelled requests with their sentence embeddings (computed once)."""
@@ -254,123 +244,160 @@ class Encoded:
         y = np.array([INTENT_LABELS.index(r.label) for r in rows], dtype=np.int64)
         return cls(texts, y, encoder.encode([normalize_text(t) for t in texts]))
 
+    @classmethod
+    def concat(cls, parts: list[Encoded]) -> Encoded:
+        return cls(
+            [t for p in parts for t in p.texts],
+            np.concatenate([p.y for p in parts]),
+            np.vstack([p.emb for p in parts]),
+        )
+
     def features(self, spec: FeatureSpec) -> NDArray[np.float32]:
         return features_from_embeddings(self.emb, self.texts, spec)
 
 
 @dataclass(frozen=True, slots=True)
 class Selection:
-    """Outcome of the hyper-parameter search on the development split."""
+    """Outcome of the hyper-parameter search over the development splits."""
 
     hyper: Hyper
-    dev_accuracy: float  # 4-class accuracy on dev (none included), train-only model
-    dev_stop_threshold: float  # highest threshold keeping dev STOP recall at 1.0
-    dev_false_stops: int
+    accuracy: float  # 4-class accuracy on the pooled held-out development requests
+    stop_threshold: float  # cost-tuned on the pooled held-out STOP probabilities
+    stop_recall: float
+    false_stops: int
 
 
-def select(train: Encoded, dev: Encoded, grid: dict[str, tuple[float, ...]]) -> Selection:
-    """Pick the hyper-parameters whose train-only model is most accurate on dev.
+def held_out_proba(
+    train: Encoded, devs: list[Encoded], spec: FeatureSpec, c: float, hyper: Hyper
+) -> NDArray[np.float64]:
+    """Probabilities of every development request from a model that did not see its split.
 
-    For each candidate the STOP threshold is the highest one that keeps STOP recall on
-    dev at 1.0; ties go to fewer false STOPs, then to the earlier candidate in the grid.
+    Split ``k`` is predicted by a model fitted on the training requests and the other
+    development splits; the rows come back in the order of ``devs``.
     """
     dim = train.emb.shape[1]
+    out = []
+    for k, held in enumerate(devs):
+        fit_on = Encoded.concat([train, *(d for j, d in enumerate(devs) if j != k)])
+        x_fit = fit_on.features(spec)
+        clf = _classifier(_fit(x_fit, fit_on.y, c), x_fit, fit_on.y, dim, spec, hyper)
+        out.append(clf.proba(held.features(spec)))
+    return np.vstack(out)
+
+
+def _decide_all(p: NDArray[np.floating], stop_threshold: float) -> NDArray[np.int64]:
+    top = p.argmax(axis=1)
+    return np.where(p[:, STOP] >= stop_threshold, STOP, top).astype(np.int64)
+
+
+def select(
+    train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...]]
+) -> Selection:
+    """Pick the hyper-parameters with the best accuracy on held-out development splits.
+
+    Each development split is predicted by a model fitted on the training requests and
+    the other development splits (leave one split out), so every split is judged by a
+    model that never saw it and was written in another round. For each candidate the
+    STOP threshold is tuned on the pooled held-out probabilities
+    (:func:`tune_stop_threshold`); the candidate with the highest pooled accuracy at its
+    threshold wins (ties: fewer false STOPs, then earlier in the grid).
+    """
+    y = np.concatenate([d.y for d in devs])
     best: tuple[float, int, Selection] | None = None
     for c, ngram_w, cue_w in itertools.product(grid["c"], grid["ngram_weight"], grid["cue_weight"]):
         spec = FeatureSpec(ngram_weight=ngram_w, cue_weight=cue_w)
-        x_tr, x_dev = train.features(spec), dev.features(spec)
-        model = _fit(x_tr, train.y, c)
+        # the logistic regression does not depend on the blend: fit once, blend after
+        p_lr = held_out_proba(train, devs, spec, c, Hyper(c, ngram_w, cue_w, 1.0))
+        p_knn_parts = []
+        for k, held in enumerate(devs):
+            ref = Encoded.concat([train, *(d for j, d in enumerate(devs) if j != k)])
+            p_knn_parts.append(knn_proba(held.emb, ref.emb, ref.y))
+        p_knn = np.vstack(p_knn_parts)
         for lr_w in grid["lr_weight"]:
             hyper = Hyper(c, ngram_w, cue_w, lr_w)
-            clf = _classifier(model, x_tr, train.y, dim, spec, hyper)
-            p = clf.proba(x_dev)
-            t = recall_stop_threshold(p[:, STOP], dev.y == STOP)
-            pred = np.array([INTENT_LABELS.index(clf.decide(row, t)) for row in p])
-            acc = float(np.mean(pred == dev.y))
-            false_stops = int(np.sum((pred == STOP) & (dev.y != STOP)))
+            p = lr_w * p_lr + (1.0 - lr_w) * p_knn
+            t = tune_stop_threshold(p[:, STOP], y == STOP)
+            pred = _decide_all(p, t)
+            acc = float(np.mean(pred == y))
+            false_stops = int(np.sum((pred == STOP) & (y != STOP)))
+            recall = float(np.mean(pred[y == STOP] == STOP))
             log.info(
-                "C=%g ngram=%g cue=%g lr=%g: dev accuracy %.3f, threshold %.2f, false STOPs %d",
+                "C=%g ngram=%g cue=%g lr=%g: held-out accuracy %.3f, STOP threshold %.2f "
+                "(recall %.3f, false STOPs %d)",
                 c,
                 ngram_w,
                 cue_w,
                 lr_w,
                 acc,
                 t,
+                recall,
                 false_stops,
             )
             if best is None or (acc, -false_stops) > (best[0], best[1]):
-                best = (acc, -false_stops, Selection(hyper, acc, t, false_stops))
+                best = (acc, -false_stops, Selection(hyper, acc, t, recall, false_stops))
     assert best is not None
     return best[2]
 
 
 def fit_final(
-    train: Encoded, dev: Encoded, hyper: Hyper, *, folds: int = 5, seed: int = 0
+    train: Encoded, devs: list[Encoded], hyper: Hyper, stop_threshold: float
 ) -> IntentClassifier:
-    """Fit on training + development requests; calibrate the STOP threshold out of fold.
-
-    The threshold minimises ``STOP_MISS_COST * missed STOPs + false STOPs`` on 5-fold
-    out-of-fold probabilities of all requests and is then lowered, if needed, so that every
-    development STOP request (out of fold) reaches it.
-    """
+    """Fit the shipped model on the training and all development requests."""
     spec = FeatureSpec(ngram_weight=hyper.ngram_weight, cue_weight=hyper.cue_weight)
-    x = np.vstack([train.features(spec), dev.features(spec)])
-    y = np.concatenate([train.y, dev.y])
-    from_dev = np.r_[np.zeros(len(train.y), bool), np.ones(len(dev.y), bool)]
+    pool = Encoded.concat([train, *devs])
+    x = pool.features(spec)
     dim = train.emb.shape[1]
-    oof = np.zeros((len(y), len(INTENT_LABELS)))
-    for tr, va in StratifiedKFold(folds, shuffle=True, random_state=seed).split(x, y):
-        fold = _fit(x[tr], y[tr], hyper.c)
-        oof[va] = _classifier(fold, x[tr], y[tr], dim, spec, hyper).proba(x[va])
-    t_cost = tune_stop_threshold(oof[:, STOP], y == STOP)
-    t_dev = recall_stop_threshold(oof[from_dev, STOP], y[from_dev] == STOP)
-    stop_t = min(t_cost, t_dev)
-    clf = _classifier(_fit(x, y, hyper.c), x, y, dim, spec, hyper, stop_t)
-    pred = np.array([INTENT_LABELS.index(clf.decide(row)) for row in oof])
-    log.info(
-        "out-of-fold (train+dev) accuracy %.3f, STOP recall %.3f; stop threshold %.2f "
-        "(cost %.2f, dev recall %.2f)",
-        float(np.mean(pred == y)),
-        float(np.mean(pred[y == STOP] == STOP)),
-        stop_t,
-        t_cost,
-        t_dev,
-    )
-    return clf
+    return _classifier(_fit(x, pool.y, hyper.c), x, pool.y, dim, spec, hyper, stop_threshold)
 
 
 def train(
     train_rows: list[CommandExample],
-    dev_rows: list[CommandExample],
+    dev_splits: list[list[CommandExample]],
     encoder: SentenceEncoder,
     grid: dict[str, tuple[float, ...]] | None = None,
 ) -> tuple[IntentClassifier, Selection]:
-    """Select hyper-parameters on dev, then fit the shipped model on train + dev."""
-    tr, dev = Encoded.of(train_rows, encoder), Encoded.of(dev_rows, encoder)
-    sel = select(tr, dev, grid or SELECTION_GRID)
+    """Select hyper-parameters and the STOP threshold on the development splits (leave one
+    split out), then fit the shipped model on everything."""
+    if len(dev_splits) < 2:
+        raise ValueError("selection needs at least two development splits")
+    tr = Encoded.of(train_rows, encoder)
+    devs = [Encoded.of(rows, encoder) for rows in dev_splits]
+    sel = select(tr, devs, grid or SELECTION_GRID)
     log.info(
-        "selected %s: dev accuracy %.3f (train-only model), dev STOP threshold %.2f, "
-        "false STOPs %d",
+        "selected %s: held-out accuracy %.3f, STOP threshold %.2f (recall %.3f, false STOPs %d)",
         sel.hyper,
-        sel.dev_accuracy,
-        sel.dev_stop_threshold,
-        sel.dev_false_stops,
+        sel.accuracy,
+        sel.stop_threshold,
+        sel.stop_recall,
+        sel.false_stops,
     )
-    return fit_final(tr, dev, sel.hyper), sel
+    return fit_final(tr, devs, sel.hyper, sel.stop_threshold), sel
 
 
 def main(argv: list[str] | None = None) -> None:
     """Retrain the shipped classifier from the shipped training and development splits."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--train", type=Path, default=data_path(TRAIN_CSV))
-    parser.add_argument("--dev", type=Path, default=data_path(DEV_CSV))
+    parser.add_argument(
+        "--dev",
+        type=Path,
+        nargs="+",
+        default=[data_path(n) for n in DEV_SPLITS],
+        help="development splits (at least two; each is held out in turn)",
+    )
     parser.add_argument("--out", type=Path, default=data_path(CLASSIFIER_NPZ))
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    train_rows, dev_rows = load_commands(args.train), load_commands(args.dev)
+    train_rows = load_commands(args.train)
+    dev_rows = [load_commands(p) for p in args.dev]
     clf, _ = train(train_rows, dev_rows, SentenceEncoder())
     clf.save(args.out)
-    log.info("wrote %s (%d + %d examples)", args.out, len(train_rows), len(dev_rows))
+    log.info(
+        "wrote %s (%d training + %d development requests)",
+        args.out,
+        len(train_rows),
+        sum(map(len, dev_rows)),
+    )
 
 
 if __name__ == "__main__":
