@@ -37,7 +37,9 @@ def test_corpus_sizes_and_dev_splits(dev_csv: str) -> None:
 
 
 def test_dev_splits_are_disjoint() -> None:
-    splits = [{r.text.lower() for r in load_commands(data_path(n))} for n in (DEV_CSV, DEV2_CSV, DEV3_CSV)]
+    splits = [
+        {r.text.lower() for r in load_commands(data_path(n))} for n in (DEV_CSV, DEV2_CSV, DEV3_CSV)
+    ]
     for i, a in enumerate(splits):
         for b in splits[i + 1 :]:
             assert a.isdisjoint(b)

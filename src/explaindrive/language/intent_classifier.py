@@ -290,9 +290,7 @@ def _decide_all(p: NDArray[np.floating], stop_threshold: float) -> NDArray[np.in
     return np.where(p[:, STOP] >= stop_threshold, STOP, top).astype(np.int64)
 
 
-def select(
-    train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...]]
-) -> Selection:
+def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...]]) -> Selection:
     """Pick the hyper-parameters with the best accuracy on held-out development splits.
 
     Each development split is predicted by a model fitted on the training requests and
