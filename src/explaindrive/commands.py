@@ -19,7 +19,7 @@ class Command(IntEnum):
     @property
     def label(self) -> str:
         """Lower-case name used in configs, files and the CLI (``fast``...)."""
-        return self.name.lower()
+        return _LABELS[self]
 
     @classmethod
     def parse(cls, value: str | int | Command) -> Command:
@@ -43,4 +43,5 @@ class Command(IntEnum):
         raise ValueError(f"unknown command {value!r}; expected one of: {names} (or 0, 1, 2)")
 
 
+_LABELS = {c: c.name.lower() for c in Command}
 COMMAND_LABELS: tuple[str, ...] = tuple(c.label for c in Command)

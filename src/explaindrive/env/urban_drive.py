@@ -57,6 +57,8 @@ _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 ENTRY_CLEAR_AFTER_S = 10  # [s] waiting for a gap before the entry stretch is cleared
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
+_LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
+_HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
 
 
 @dataclass(slots=True)
@@ -195,7 +197,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         )
         self._apply_schedule(0.0)
         self._ep.pos_m = start_pos
-        obs, _leader, _ = self._observe()
+        api = self._conn.api
+        obs, _leader, _ = self._observe(api, api.vehicle.getSubscriptionResults(EGO_ID))
         self._last_obs = obs
         info = {
             "command": self._ep.command.label,
@@ -242,8 +245,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         collided = bool(sim.get(tc.VAR_COLLIDING_VEHICLES_IDS)) and self._ego_collided()
         arrived = not collided and EGO_ID in sim.get(tc.VAR_ARRIVED_VEHICLES_IDS, ())
         present = not collided and not arrived
-        if present:
-            ego = api.vehicle.getSubscriptionResults(EGO_ID)
+        ego = api.vehicle.getSubscriptionResults(EGO_ID) if present else None
+        if ego is not None:
             v_new = float(ego[tc.VAR_SPEED])
             ep.pos_m = ep.start_pos_m + float(ego[tc.VAR_DISTANCE])
         else:
@@ -259,8 +262,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep.speed_mps, ep.accel_mps2 = v_new, accel
         self._apply_schedule(ep.steps * STEP_LENGTH_S)
 
-        if present:
-            obs, leader, real = self._observe()
+        if ego is not None:
+            obs, leader, real = self._observe(api, ego)
         else:
             obs, leader, real = prev_obs.copy(), None, None
             obs[S.V_EGO] = v_new
@@ -458,29 +461,34 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         res = self._conn.api.edge.getSubscriptionResults(edge)
         return tuple(res.get(tc.LAST_STEP_PERSON_ID_LIST, ()))
 
-    def _crossing_occupied(self, crossing: RouteCrossing, on_it: bool) -> bool:
-        """A pedestrian is on the crossing or, at a zebra, about to step onto it.
+    def _crossing_occupied(self, crossing: RouteCrossing, on_it: bool) -> tuple[bool, bool]:
+        """(busy, on_crossing): a pedestrian is on the crossing or, at a zebra, about to
+        step onto it; and whether one is on the crossing itself.
 
         At a signalized crossing pedestrians waiting on the kerb wait for their own
         green, and once the ego is on the crossing (``on_it``) those on the kerb wait for
         it, so then only pedestrians already on the crossing count.
         """
         if self._persons(crossing.crossing_edge):
-            return True
+            return True, True
         if crossing.signalized or on_it:
-            return False
+            return False, False
         person = self._conn.api.person
-        return any(
+        entering = any(
             person.getNextEdge(pid) == crossing.crossing_edge
             for wa in crossing.walkingareas
             for pid in self._persons(wa)
         )
+        return entering, False
 
-    def _observe(self) -> tuple[NDArray[np.float32], _Leader | None, _Leader | None]:
-        """Observation, effective leader (real or virtual) and real leader."""
-        api = self._conn.api
+    def _observe(
+        self, api: Any, ego: Any
+    ) -> tuple[NDArray[np.float32], _Leader | None, _Leader | None]:
+        """Observation, effective leader (real or virtual) and real leader.
+
+        ``ego`` is the ego's subscription result of the current step.
+        """
         ep = self._episode()
-        ego = api.vehicle.getSubscriptionResults(EGO_ID)
         v = float(ego[tc.VAR_SPEED])
         pos = ep.pos_m
         rng = S.SENSOR_RANGE_M
@@ -520,28 +528,29 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             # Relevant from sensor range until the ego's front has left the junction: a car
             # stopped on the crossing (e.g. by a STOP command) must not roll into pedestrians.
             if crossing.stop_line_m - crossing.end_m <= ahead < rng:
-                busy = self._crossing_occupied(crossing, on_it=ahead < 0.0)
-                ep.occupied[crossing.crossing_edge] = bool(self._persons(crossing.crossing_edge))
+                busy, on_crossing = self._crossing_occupied(crossing, on_it=ahead < 0.0)
+                ep.occupied[crossing.crossing_edge] = on_crossing
                 if busy:
                     d_cross = min(d_cross, max(ahead, 0.0))
         if d_cross < rng and (leader is None or d_cross < leader.gap_m):
             leader = _Leader(d_cross, 0.0, 0.0, True)
 
+        values = (
+            float(ep.command),
+            v,
+            self.geometry.posted_limit(pos),
+            leader.gap_m if leader else rng,
+            (v - leader.speed_mps) if leader else 0.0,
+            d_tl,
+            float(tls),
+            d_cross,
+        )
+        # clipped in Python (the bounds are float32 values, so rounding afterwards gives
+        # the same result as clipping the float32 array): cheaper than two numpy calls
         obs = np.array(
-            [
-                float(ep.command),
-                v,
-                self.geometry.posted_limit(pos),
-                leader.gap_m if leader else rng,
-                (v - leader.speed_mps) if leader else 0.0,
-                d_tl,
-                float(tls),
-                d_cross,
-            ],
+            [min(max(x, lo), hi) for x, lo, hi in zip(values, _LOW, _HIGH, strict=True)],
             dtype=np.float32,
         )
-        np.maximum(obs, S.STATE_LOW, out=obs)
-        np.minimum(obs, S.STATE_HIGH, out=obs)
         return obs, leader, real
 
     def _ran_red_light(self, prev_pos: float, pos: float) -> bool:
