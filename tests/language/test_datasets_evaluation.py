@@ -12,9 +12,7 @@ from explaindrive.language.backends.embedded import RuleDecider, TemplateExplain
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
-    DEV2_CSV,
-    DEV3_CSV,
-    DEV_CSV,
+    DEV_SPLITS,
     TEST_CSV,
     TRAIN_CSV,
     data_path,
@@ -26,7 +24,7 @@ from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
 NEAR_COPY = 0.8  # character similarity (difflib ratio) from which a text counts as a near-copy
 
 
-@pytest.mark.parametrize("dev_csv", [DEV_CSV, DEV2_CSV, DEV3_CSV])
+@pytest.mark.parametrize("dev_csv", DEV_SPLITS)
 def test_corpus_sizes_and_dev_splits(dev_csv: str) -> None:
     train, dev = load_commands(data_path(TRAIN_CSV)), load_commands(data_path(dev_csv))
     assert len(train) + len(dev) >= 400 and len(dev) >= 120
@@ -37,9 +35,7 @@ def test_corpus_sizes_and_dev_splits(dev_csv: str) -> None:
 
 
 def test_dev_splits_are_disjoint() -> None:
-    splits = [
-        {r.text.lower() for r in load_commands(data_path(n))} for n in (DEV_CSV, DEV2_CSV, DEV3_CSV)
-    ]
+    splits = [{r.text.lower() for r in load_commands(data_path(n))} for n in DEV_SPLITS]
     for i, a in enumerate(splits):
         for b in splits[i + 1 :]:
             assert a.isdisjoint(b)
@@ -52,9 +48,7 @@ def test_held_out_test_split() -> None:
     assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
     assert {"direct", "indirect", "negation", "noise", "offtopic"} <= {r.kind for r in test}
     seen = {
-        r.text.lower()
-        for name in (TRAIN_CSV, DEV_CSV, DEV2_CSV, DEV3_CSV)
-        for r in load_commands(data_path(name))
+        r.text.lower() for name in (TRAIN_CSV, *DEV_SPLITS) for r in load_commands(data_path(name))
     }
     near_copies = [
         (t.text, s)
@@ -66,7 +60,7 @@ def test_held_out_test_split() -> None:
     assert near_copies == []
 
 
-@pytest.mark.parametrize("dev_csv", [DEV_CSV, DEV2_CSV, DEV3_CSV])
+@pytest.mark.parametrize("dev_csv", DEV_SPLITS)
 def test_shipped_classifier_keeps_stop_recall_on_dev(interpreter, dev_csv: str) -> None:  # type: ignore[no-untyped-def]
     rows = [r for r in load_commands(data_path(dev_csv)) if r.label == "stop"]
     missed = [r.text for r in rows if interpreter.interpret(r.text).intent is not Command.STOP]

@@ -34,7 +34,9 @@ DEV2_CSV = "commands_dev2.csv"
 """Second development split (a former test split, evaluated once): selection and refit."""
 DEV3_CSV = "commands_dev3.csv"
 """Third development split (a former test split, evaluated by two models)."""
-DEV_SPLITS: tuple[str, ...] = (DEV_CSV, DEV2_CSV, DEV3_CSV)
+DEV4_CSV = "commands_dev4.csv"
+"""Fourth development split (a former test split, evaluated once)."""
+DEV_SPLITS: tuple[str, ...] = (DEV_CSV, DEV2_CSV, DEV3_CSV, DEV4_CSV)
 """The development splits, each written in its own round; LLM-1 selection holds each out."""
 TEST_CSV = "commands_test.csv"
 """Held-out requests, written before the current model and never used to build it."""
