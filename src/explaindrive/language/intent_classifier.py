@@ -70,7 +70,7 @@ class Hyper:
 SELECTION_GRID: dict[str, tuple[float, ...]] = {
     "c": (10.0, 100.0),
     "ngram_weight": (1.0, 1.5),
-    "cue_weight": (0.0, 1.0, 2.0, 3.0),
+    "cue_weight": (0.0, 1.0, 2.0, 3.0, 4.0),
     "lr_weight": (0.35, 0.5, 0.75, 1.0),
 }
 
