@@ -9,8 +9,10 @@ from explaindrive.language.features import FeatureSpec
 from explaindrive.language.intent_classifier import (
     Encoded,
     Hyper,
+    decide_rows,
     held_out_proba,
     select,
+    tune_none_margin,
     tune_stop_threshold,
 )
 
@@ -26,6 +28,38 @@ def test_stop_threshold_minimises_weighted_cost() -> None:
     assert tune_stop_threshold(np.array([0.3, 0.8, 0.2]), np.array([True, True, False])) == (
         pytest.approx(0.21)
     )
+
+
+def test_decision_rule() -> None:
+    p = np.array(
+        [
+            [0.30, 0.10, 0.25, 0.35],  # STOP reaches 0.2; none leads the best command by 0.05
+            [0.30, 0.10, 0.05, 0.55],  # none leads the best command by 0.25
+            [0.40, 0.05, 0.05, 0.50],  # none leads by 0.10
+        ]
+    )
+    # labels: 0 fast, 1 comfort, 2 stop, 3 none
+    assert decide_rows(p, 0.2, 0.0).tolist() == [2, 3, 3]
+    assert decide_rows(p, 0.3, 0.0).tolist() == [3, 3, 3]
+    assert decide_rows(p, 0.3, 0.15).tolist() == [0, 3, 0]  # leads up to 0.15: a command
+    assert decide_rows(p, 0.3, 0.3).tolist() == [0, 0, 0]
+
+
+def test_none_margin_weighs_dropped_commands_double() -> None:
+    # none leads the best command by 0.27 (a fast request), 0.12 (a fast request), 0.22
+    # and 0.33 (two off-topic requests). Cost = 2 * dropped commands + answered off-topic:
+    # m < 0.12: 2 * 2 = 4; [0.12, 0.22): 2; [0.22, 0.27): 2 + 1 = 3; [0.27, 0.33): 0 + 1 = 1;
+    # m >= 0.33: 2. On the 0.05 grid the best margin is 0.30.
+    p = np.array(
+        [
+            [0.28, 0.10, 0.07, 0.55],
+            [0.38, 0.05, 0.07, 0.50],
+            [0.28, 0.10, 0.12, 0.50],
+            [0.22, 0.10, 0.13, 0.55],
+        ]
+    )
+    y = np.array([0, 0, 3, 3])
+    assert tune_none_margin(p, y, stop_threshold=0.5) == pytest.approx(0.3)
 
 
 def _split(texts: list[str], labels: list[int], seed: int) -> Encoded:

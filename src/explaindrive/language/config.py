@@ -44,8 +44,9 @@ class EmbeddedConfig(_Strict):
     stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
     """STOP wins whenever its probability reaches this; ``None`` = the value stored with the
     weights (tuned on the training split)."""
-    none_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
-    """Below this top probability a request is treated as off-topic; ``None`` = stored value."""
+    none_margin: float | None = Field(default=None, ge=0.0, le=1.0)
+    """A request is off-topic only when its off-topic probability exceeds the best command's
+    by more than this; ``None`` = the value stored with the weights."""
     encoder_threads: int = Field(default=1, ge=1)
     """torch threads while encoding a request (1 is fastest on a CPU shared with SUMO)."""
     cutoff_m: float = Field(default=SUMMARY_CUTOFF_M, gt=0.0)

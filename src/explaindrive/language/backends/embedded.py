@@ -51,7 +51,7 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
             return IntentResult(None, REPHRASE_MESSAGE, NAME, False, time.perf_counter() - t0, {})
         x = features(self.encoder, [text], self.classifier.spec)
         p = self.classifier.proba(x)[0]
-        label = self.classifier.decide(p, self.config.stop_threshold, self.config.none_threshold)
+        label = self.classifier.decide(p, self.config.stop_threshold, self.config.none_margin)
         scores = {name: round(float(v), 4) for name, v in zip(INTENT_LABELS, p, strict=True)}
         intent = None if label == "none" else Command.parse(label)
         confirmation = format_confirmation(intent) if intent is not None else REPHRASE_MESSAGE
