@@ -14,8 +14,9 @@ from explaindrive.env.state import CMD
 from explaindrive.language.decision import Conflict, Decision, ExplanationDecider, Factor
 from explaindrive.language.explanation import Explainer, Explanation
 from explaindrive.language.intent import IntentInterpreter, IntentResult, format_confirmation
+from explaindrive.language.speech import Transcript
+from explaindrive.language.stack import LanguageStack
 from explaindrive.language.summary import StateRecord
-from explaindrive.ride.language import RideLanguage
 
 
 class ScriptedController:
@@ -83,8 +84,21 @@ class EchoExplainer(Explainer):
         return Explanation(f"slowing for {factor}", factor, self.name)
 
 
-def fake_language(delay_s: float = 0.0) -> RideLanguage:
-    def transcribe(path: Path) -> str:
-        return path.stem.replace("_", " ")
+class FileNameTranscriber:
+    """Stands in for Whisper: the file's name is what was 'said' ("go_faster.wav")."""
 
-    return RideLanguage(KeywordInterpreter(delay_s), BrakingDecider(), EchoExplainer(), transcribe)
+    def load(self) -> None:
+        pass
+
+    def transcribe(self, path: str | Path) -> Transcript:
+        return Transcript(Path(path).stem.replace("_", " "), 1.0, 0.0, "en")
+
+
+def fake_language(delay_s: float = 0.0) -> LanguageStack:
+    return LanguageStack(
+        "fake",
+        KeywordInterpreter(delay_s),
+        BrakingDecider(),
+        EchoExplainer(),
+        FileNameTranscriber(),
+    )

@@ -12,8 +12,8 @@ import pytest
 from explaindrive.agent.controller import MergedController
 from explaindrive.env.metrics import stop_latency_bound
 from explaindrive.language.config import LanguageConfig, OpenAIConfig
+from explaindrive.language.stack import LanguageStack, make_language_stack
 from explaindrive.ride.config import RideConfig
-from explaindrive.ride.language import RideLanguage, build_language
 from explaindrive.ride.runner import run_ride
 from explaindrive.ride.script import ScriptLine, default_script_path, load_script
 from explaindrive.ride.session import RideSession
@@ -22,15 +22,15 @@ from ..language.conftest import ScriptedOpenAI
 
 
 @pytest.fixture(scope="module")
-def language() -> RideLanguage:
-    return build_language("embedded", speech=True)
+def language() -> LanguageStack:
+    return make_language_stack("embedded").load(speech=True)
 
 
 def passenger_events(session: RideSession, kind: str) -> list[dict]:
     return [e for r in session.records for e in r.passenger if e["type"] == kind]
 
 
-def test_default_ride_fast_stop_comfort(language: RideLanguage, tmp_path: Path) -> None:
+def test_default_ride_fast_stop_comfort(language: LanguageStack, tmp_path: Path) -> None:
     # Seed 3 meets J1 on red while the passenger wants to go fast.
     session = RideSession(RideConfig(seed=3), MergedController.from_package(), language)
     out = run_ride(session, load_script(default_script_path()), tmp_path)
@@ -53,7 +53,7 @@ def test_default_ride_fast_stop_comfort(language: RideLanguage, tmp_path: Path) 
 
 
 @pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed")
-def test_spoken_lines_go_through_whisper(language: RideLanguage, tmp_path: Path) -> None:
+def test_spoken_lines_go_through_whisper(language: LanguageStack, tmp_path: Path) -> None:
     def speak(text: str, name: str) -> Path:
         path = tmp_path / f"{name}.wav"
         subprocess.run(["espeak-ng", "-s", "140", "-w", str(path), text], check=True)
@@ -88,7 +88,7 @@ def test_openai_backend_that_times_out_falls_back(tmp_path: Path) -> None:
         config = LanguageConfig(
             openai=OpenAIConfig(base_url=server.base_url, api_key="test", timeout_s=0.3)
         )
-        language = build_language("openai", config)
+        language = make_language_stack("openai", config).load()
         session = RideSession(
             RideConfig(max_steps=12, backend="openai"), MergedController.from_package(), language
         )

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import pytest
 from fastapi.testclient import TestClient
 
+from explaindrive.language.speech import Transcript
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.web import create_app
@@ -19,15 +21,20 @@ from ..ride.fakes import ScriptedController, fake_language
 STEP_PERIOD_S = 0.05  # [s] twenty control steps per second of wall time
 
 
-def _transcribe(path: Path) -> str:
+class UploadTranscriber:
     """Stands in for Whisper: a WAV upload 'says' it is in a hurry, anything else is silence."""
-    return "please hurry" if path.read_bytes()[:4] == b"RIFF" else ""
+
+    def load(self) -> None:
+        pass
+
+    def transcribe(self, path: str | Path) -> Transcript:
+        text = "please hurry" if Path(path).read_bytes()[:4] == b"RIFF" else ""
+        return Transcript(text, 1.0, 0.0, "en")
 
 
 def fake_session_factory(config: RideConfig) -> RideSession:
     """A ride over live SUMO with the rule-based driver and keyword language modules."""
-    language = fake_language()
-    language.transcribe = _transcribe
+    language = replace(fake_language(), transcriber=UploadTranscriber())
     return RideSession(config, ScriptedController(), language)
 
 

@@ -43,7 +43,7 @@ def real_stack_available() -> bool:
     """Whether the shipped policies exist and the embedded language layer can be built."""
     try:
         from explaindrive.agent.controller import shipped_policy_path
-        from explaindrive.ride.language import build_language  # noqa: F401
+        from explaindrive.language.stack import make_language_stack  # noqa: F401
 
         return all(shipped_policy_path(name).is_file() for name in ("fast", "comfort"))
     except (ImportError, FileNotFoundError, ValueError):

@@ -49,7 +49,7 @@ def ride(
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.controller import MergedController
-    from explaindrive.ride.language import build_language
+    from explaindrive.language.stack import make_language_stack
     from explaindrive.ride.runner import run_ride
     from explaindrive.ride.session import RideSession
     from explaindrive.ride.view import render
@@ -82,7 +82,7 @@ def ride(
     if interactive:
         typed = queue.Queue()
         _start_input_thread(typed, voice)
-    language = build_language(backend, speech=voice or any(ln.audio for ln in lines))
+    language = make_language_stack(backend).load(speech=voice or any(ln.audio for ln in lines))
     session = RideSession(config, controller, language)
     if script is None and not interactive:
         console.print(f"default ride script: {default_script_path()}")

@@ -7,7 +7,7 @@ import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -103,6 +103,20 @@ def load_audio(path: str | Path, config: SpeechConfig | None = None) -> np.ndarr
     if rms < cfg.silence_rms:
         raise AudioError(f"{p.name}: audio is silent (RMS {rms:.1e}); no request heard")
     return audio
+
+
+class SpeechToText(Protocol):
+    """What the ride needs from speech recognition (Whisper, or a stand-in in tests)."""
+
+    def load(self) -> None:
+        """Load the model now rather than on first use."""
+
+    def transcribe(self, path: str | Path) -> Transcript:
+        """The text spoken in the audio file ``path``.
+
+        Raises:
+            AudioError: for unusable audio.
+        """
 
 
 class Transcriber:

@@ -14,7 +14,7 @@ from explaindrive.language.config import LanguageConfig
 from explaindrive.language.decision import ExplanationDecider
 from explaindrive.language.explanation import Explainer
 from explaindrive.language.intent import IntentInterpreter
-from explaindrive.language.speech import Transcriber
+from explaindrive.language.speech import SpeechToText, Transcriber
 
 
 @dataclass(frozen=True)
@@ -25,7 +25,19 @@ class LanguageStack:
     interpreter: IntentInterpreter
     decider: ExplanationDecider
     explainer: Explainer
-    transcriber: Transcriber
+    transcriber: SpeechToText
+
+    def load(self, speech: bool = False) -> LanguageStack:
+        """Load the interpreter's model now (and Whisper's with ``speech``); returns self.
+
+        A ride calls this before it starts so that no request pays the load time.
+        """
+        load = getattr(self.interpreter, "load", None)
+        if callable(load):
+            load()
+        if speech:
+            self.transcriber.load()
+        return self
 
 
 def make_language_stack(

@@ -17,7 +17,7 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,7 +35,9 @@ from explaindrive.language.speech import AudioError
 from explaindrive.language.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.lane import LanguageLane, Outcome
-from explaindrive.ride.language import RideLanguage
+
+if TYPE_CHECKING:
+    from explaindrive.language.stack import LanguageStack
 
 log = logging.getLogger(__name__)
 
@@ -121,7 +123,7 @@ class RideSession:
         self,
         config: RideConfig,
         controller: MergedController,
-        language: RideLanguage,
+        language: LanguageStack,
         env: UrbanDriveEnv | None = None,
     ) -> None:
         self.config = config
@@ -219,7 +221,7 @@ class RideSession:
         if req.audio is not None:
             t0 = time.perf_counter()
             try:
-                text = self.language.transcribe(req.audio)
+                text = self.language.transcriber.transcribe(req.audio).text
             except AudioError as exc:
                 return "", None, time.perf_counter() - t0, str(exc)
             transcript_s = time.perf_counter() - t0

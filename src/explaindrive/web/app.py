@@ -69,12 +69,12 @@ class RealStack:
         from dataclasses import replace
 
         from explaindrive.agent.controller import MergedController
-        from explaindrive.ride.language import build_language
+        from explaindrive.language.stack import make_language_stack
 
         if self._controller is None:
             self._controller = MergedController.from_package()
         if self._language is None:
-            self._language = build_language(self.backend)
+            self._language = make_language_stack(self.backend).load()
         return RideSession(replace(config, backend=self.backend), self._controller, self._language)
 
 
