@@ -43,7 +43,7 @@ class EmbeddedConfig(_Strict):
     """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data``."""
     stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
     """STOP wins whenever its probability reaches this; ``None`` = the value stored with the
-    weights (tuned on the training split)."""
+    weights (tuned on the held-out development splits)."""
     none_margin: float | None = Field(default=None, ge=0.0, le=1.0)
     """A request is off-topic only when its off-topic probability exceeds the best command's
     by more than this; ``None`` = the value stored with the weights."""
