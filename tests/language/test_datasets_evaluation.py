@@ -13,7 +13,7 @@ from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
     DEV_SPLITS,
-    TEST_CSV,
+    TEST_SPLITS,
     TRAIN_CSV,
     data_path,
     load_commands,
@@ -41,15 +41,15 @@ def test_dev_splits_are_disjoint() -> None:
             assert a.isdisjoint(b)
 
 
-def test_held_out_test_split() -> None:
-    test = load_commands(data_path(TEST_CSV))
+@pytest.mark.parametrize("test_csv", TEST_SPLITS)
+def test_held_out_test_split(test_csv: str) -> None:
+    test = load_commands(data_path(test_csv))
     assert len(test) >= 150
     counts = Counter(r.label for r in test)
     assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
     assert {"direct", "indirect", "negation", "noise", "offtopic"} <= {r.kind for r in test}
-    seen = {
-        r.text.lower() for name in (TRAIN_CSV, *DEV_SPLITS) for r in load_commands(data_path(name))
-    }
+    others = (TRAIN_CSV, *DEV_SPLITS, *(t for t in TEST_SPLITS if t != test_csv))
+    seen = {r.text.lower() for name in others for r in load_commands(data_path(name))}
     near_copies = [
         (t.text, s)
         for t in test

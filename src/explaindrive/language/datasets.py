@@ -38,12 +38,13 @@ DEV4_CSV = "commands_dev4.csv"
 """Fourth development split (a former test split, evaluated once)."""
 DEV5_CSV = "commands_dev5.csv"
 """Fifth development split (a former test split, evaluated once)."""
-DEV6_CSV = "commands_dev6.csv"
-"""Sixth development split (a former test split, evaluated once)."""
-DEV_SPLITS: tuple[str, ...] = (DEV_CSV, DEV2_CSV, DEV3_CSV, DEV4_CSV, DEV5_CSV, DEV6_CSV)
+DEV_SPLITS: tuple[str, ...] = (DEV_CSV, DEV2_CSV, DEV3_CSV, DEV4_CSV, DEV5_CSV)
 """The development splits, each written in its own round; LLM-1 selection holds each out."""
 TEST_CSV = "commands_test.csv"
-"""Held-out requests, written before the current model and never used to build it."""
+"""Held-out requests, written before the shipped model and never used to build it."""
+TEST2_CSV = "commands_test2.csv"
+"""A second held-out split, written after the shipped model was built."""
+TEST_SPLITS: tuple[str, ...] = (TEST_CSV, TEST2_CSV)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 
