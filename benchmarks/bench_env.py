@@ -12,7 +12,7 @@ For each seed, two stretches run back to back from the same warmed-up state:
 Pairing the stretches seed by seed keeps slow drifts of the machine's load out of the
 ratio. Target: env >= 75 % of raw.
 
-    python benchmarks/bench_env.py [--episodes 12] [--traffic 1.0]
+    python benchmarks/bench_env.py [--episodes 60] [--traffic 1.0]
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ def raw_stretch(env: UrbanDriveEnv, seed: int, traffic: float, speeds: list[floa
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--episodes", type=int, default=12)
+    parser.add_argument("--episodes", type=int, default=60)
     parser.add_argument("--traffic", type=float, default=1.0)
     args = parser.parse_args()
     env = UrbanDriveEnv()
