@@ -110,3 +110,21 @@ def test_discussion_is_computed_from_the_numbers() -> None:
     assert "0/1 collision episodes vs 0/25" in text
     # comfort (8 m/s) is faster than fast (4 m/s): the ordering is not reproduced for speed
     assert "is not reproduced for speed and reproduced for headway" in text
+
+
+def test_speed_panels_take_each_run_its_own_traces() -> None:
+    from types import SimpleNamespace
+
+    from explaindrive.evaluation.report import _speed_panels
+
+    plan = SimpleNamespace(policies={"fast": None, "krauss": None})
+    by_run = {
+        "fast": [SimpleNamespace(speeds_mps=(5.0, 6.0))],
+        "fast + stops": [SimpleNamespace(speeds_mps=(5.0, 0.0))],
+        "krauss": [SimpleNamespace(speeds_mps=(7.0,))],
+    }
+    assert _speed_panels(plan, by_run, ("fast", "comfort")) == {  # type: ignore[arg-type]
+        "fast": [(5.0, 6.0)],
+        "fast + stops": [(5.0, 0.0)],
+    }
+    assert _speed_panels(plan, by_run, ("krauss",)) == {"krauss": [(7.0,)]}  # type: ignore[arg-type]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 import logging
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -182,6 +182,19 @@ def run_report(
     return ReportResult(md, written, by_run)
 
 
+def _speed_panels(
+    plan: ReportPlan, by_run: Mapping[str, list[EpisodeRecord]], group: Collection[str]
+) -> dict[str, list[tuple[float, ...]]]:
+    """Speed traces per run, for each policy of ``group``: its plain run and its stop run."""
+    return {
+        title: [r.speeds_mps for r in by_run[title]]
+        for name in plan.policies
+        if name in group
+        for title in (name, f"{name} + stops")
+        if title in by_run
+    }
+
+
 def _figures(
     plan: ReportPlan,
     by_run: Mapping[str, list[EpisodeRecord]],
@@ -190,25 +203,13 @@ def _figures(
 ) -> list[Path]:
     stops = {run.name: run.stop_intervals for run in plan.runs}
     written: list[Path] = []
-    agent_panels = {
-        title: [r.speeds_mps for r in by_run[name]]
-        for name in plan.policies
-        if name in AGENTS
-        for title in (name, f"{name} + stops")
-        if title in by_run
-    }
+    agent_panels = _speed_panels(plan, by_run, AGENTS)
     if agent_panels:
         written.append(figs.plot_speed_bands(
             agent_panels, figures_dir / "speed_profiles.png", stop_intervals=stops,
             title="Ego speed, mean ± 1 std over the episodes",
         ))  # fmt: skip
-    base_panels = {
-        title: [r.speeds_mps for r in by_run[title]]
-        for name in plan.policies
-        if name in BASELINES
-        for title in (name, f"{name} + stops")
-        if title in by_run
-    }
+    base_panels = _speed_panels(plan, by_run, BASELINES)
     if base_panels:
         written.append(figs.plot_speed_bands(
             base_panels, figures_dir / "baseline_speed_profiles.png", stop_intervals=stops,
