@@ -17,6 +17,7 @@ from pydantic import ConfigDict, ValidationError
 
 from explaindrive.language.decision import Factor
 from explaindrive.language.summary import StateRecord
+from explaindrive.validation import describe_errors
 
 INTENT_LABELS: tuple[str, ...] = ("fast", "comfort", "stop", "none")
 
@@ -124,10 +125,7 @@ def load_decisions(path: str | Path) -> list[LabelledRecord]:
         try:
             rec = LabelledRecord.model_validate(raw)
         except ValidationError as exc:
-            problems = "; ".join(
-                f"{'.'.join(str(x) for x in e['loc'])}: {e['msg']}" for e in exc.errors()
-            )
-            raise ValueError(f"{p}:{line_no}: invalid record: {problems}") from exc
+            raise ValueError(f"{p}:{line_no}: invalid record: {describe_errors(exc)}") from exc
         if rec.explain and rec.factor is None:
             raise ValueError(f"{p}:{line_no}: explain is true but factor is null")
         out.append(rec)

@@ -23,6 +23,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from explaindrive.commands import Command
 from explaindrive.env.state import SENSOR_RANGE_M, DrivingState, LightState
 from explaindrive.language.config import SUMMARY_CUTOFF_M
+from explaindrive.validation import describe_errors
 
 _M = TypeVar("_M", bound=BaseModel)
 
@@ -172,10 +173,7 @@ def _parse(model: type[_M], text: str, source: str) -> _M:
     try:
         return model.model_validate(raw)
     except ValidationError as exc:
-        problems = "; ".join(
-            f"{'.'.join(str(x) for x in e['loc']) or '<root>'}: {e['msg']}" for e in exc.errors()
-        )
-        raise ValueError(f"{source}: invalid state record: {problems}") from exc
+        raise ValueError(f"{source}: invalid state record: {describe_errors(exc)}") from exc
 
 
 def describe_action(change_mps: int) -> str:

@@ -21,6 +21,8 @@ from typing import Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from explaindrive.validation import describe_errors
+
 AUDIO_PREFIX = "@audio:"  # a typed passenger line that names a recorded audio file
 
 
@@ -88,10 +90,9 @@ def load_script(path: str | Path, max_time_s: float | None = None) -> list[Scrip
         try:
             line = ScriptLine.model_validate(item)
         except ValidationError as exc:
-            problems = "; ".join(
-                f"{'.'.join(str(p) for p in e['loc']) or 'line'}: {e['msg']}" for e in exc.errors()
-            )
-            raise ScriptError(f"ride script {path}, line {i}: {problems}") from exc
+            raise ScriptError(
+                f"ride script {path}, line {i}: {describe_errors(exc, root='line')}"
+            ) from exc
         if line.audio is not None and not line.audio.is_absolute():
             line = line.model_copy(update={"audio": path.parent / line.audio})
         if max_time_s is not None and line.t > max_time_s:
