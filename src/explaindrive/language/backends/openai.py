@@ -7,10 +7,11 @@ says so (``fallback=True``, ``error=...``).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import time
-from typing import Any
+from typing import Any, TypeVar
 
 from explaindrive.language.backends.embedded import (
     EmbeddedIntentInterpreter,
@@ -122,6 +123,16 @@ def _err(exc: Exception) -> str:
     return f"{type(exc).__name__}: {exc}"[:300]
 
 
+_R = TypeVar("_R", IntentResult, Decision, Explanation)
+
+
+def _as_fallback(result: _R, t0: float, exc: Exception) -> _R:
+    """The embedded module's ``result``, marked as a fallback for ``exc``, timed from ``t0``."""
+    return dataclasses.replace(
+        result, fallback=True, latency_s=time.perf_counter() - t0, error=_err(exc)
+    )
+
+
 class OpenAIIntentInterpreter(IntentInterpreter):
     """LLM-1 through the endpoint; falls back to the embedded interpreter."""
 
@@ -145,16 +156,7 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             )
         except Exception as exc:  # any endpoint failure: answer offline instead
             log.warning("openai intent failed, using embedded: %s", _err(exc))
-            r = self.fallback.interpret(text)
-            return IntentResult(
-                r.intent,
-                r.confirmation,
-                r.backend,
-                True,
-                time.perf_counter() - t0,
-                r.scores,
-                _err(exc),
-            )
+            return _as_fallback(self.fallback.interpret(text), t0, exc)
 
 
 class OpenAIDecider(ExplanationDecider):
@@ -191,17 +193,7 @@ class OpenAIDecider(ExplanationDecider):
             )
         except Exception as exc:
             log.warning("openai decision failed, using rules: %s", _err(exc))
-            d = self.fallback.decide(record)
-            return Decision(
-                d.explain,
-                d.factor,
-                d.conflict,
-                d.reason,
-                d.backend,
-                True,
-                time.perf_counter() - t0,
-                _err(exc),
-            )
+            return _as_fallback(self.fallback.decide(record), t0, exc)
 
 
 class OpenAIExplainer(Explainer):
@@ -234,7 +226,4 @@ class OpenAIExplainer(Explainer):
             return Explanation(reply, factor, NAME, latency_s=time.perf_counter() - t0)
         except Exception as exc:
             log.warning("openai explanation failed, using templates: %s", _err(exc))
-            e = self.fallback.explain(record, factor)
-            return Explanation(
-                e.text, e.factor, e.backend, True, time.perf_counter() - t0, _err(exc)
-            )
+            return _as_fallback(self.fallback.explain(record, factor), t0, exc)
