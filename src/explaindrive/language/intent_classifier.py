@@ -320,12 +320,23 @@ def held_out_proba(
     development splits; the rows come back in the order of ``devs``.
     """
     dim = train.emb.shape[1]
+    x_train, x_devs = train.features(spec), [d.features(spec) for d in devs]  # once per split
+    out = []
+    for k in range(len(devs)):
+        x_fit = np.vstack([x_train, *(x for j, x in enumerate(x_devs) if j != k)])
+        y_fit = np.concatenate([train.y, *(d.y for j, d in enumerate(devs) if j != k)])
+        clf = _classifier(_fit(x_fit, y_fit, c), x_fit, y_fit, dim, spec, hyper)
+        out.append(clf.proba(x_devs[k]))
+    return np.vstack(out)
+
+
+def held_out_knn_proba(train: Encoded, devs: list[Encoded]) -> NDArray[np.float64]:
+    """The nearest-neighbour vote for every development request, over the training requests
+    and the other development splits (rows in the order of ``devs``)."""
     out = []
     for k, held in enumerate(devs):
-        fit_on = Encoded.concat([train, *(d for j, d in enumerate(devs) if j != k)])
-        x_fit = fit_on.features(spec)
-        clf = _classifier(_fit(x_fit, fit_on.y, c), x_fit, fit_on.y, dim, spec, hyper)
-        out.append(clf.proba(held.features(spec)))
+        ref = Encoded.concat([train, *(d for j, d in enumerate(devs) if j != k)])
+        out.append(knn_proba(held.emb, ref.emb, ref.y))
     return np.vstack(out)
 
 
@@ -340,16 +351,12 @@ def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...
     threshold wins (ties: fewer false STOPs, then earlier in the grid).
     """
     y = np.concatenate([d.y for d in devs])
+    p_knn = held_out_knn_proba(train, devs)  # depends on the embeddings only
     best: tuple[float, int, Selection] | None = None
     for c, ngram_w, cue_w in itertools.product(grid["c"], grid["ngram_weight"], grid["cue_weight"]):
         spec = FeatureSpec(ngram_weight=ngram_w, cue_weight=cue_w)
         # the logistic regression does not depend on the blend: fit once, blend after
         p_lr = held_out_proba(train, devs, spec, c, Hyper(c, ngram_w, cue_w, 1.0))
-        p_knn_parts = []
-        for k, held in enumerate(devs):
-            ref = Encoded.concat([train, *(d for j, d in enumerate(devs) if j != k)])
-            p_knn_parts.append(knn_proba(held.emb, ref.emb, ref.y))
-        p_knn = np.vstack(p_knn_parts)
         for lr_w in grid["lr_weight"]:
             hyper = Hyper(c, ngram_w, cue_w, lr_w)
             p = lr_w * p_lr + (1.0 - lr_w) * p_knn
