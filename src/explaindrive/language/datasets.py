@@ -45,7 +45,9 @@ TEST_CSV = "commands_test.csv"
 """Held-out requests, written before the shipped model and never used to build it."""
 TEST2_CSV = "commands_test2.csv"
 """A second held-out split, written after the shipped model was built."""
-TEST_SPLITS: tuple[str, ...] = (TEST_CSV, TEST2_CSV)
+TEST3_CSV = "commands_test3.csv"
+"""A third held-out split (round 8), written before the next model was built."""
+TEST_SPLITS: tuple[str, ...] = (TEST_CSV, TEST2_CSV, TEST3_CSV)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 
