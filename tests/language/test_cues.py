@@ -30,6 +30,14 @@ def cues(text: str) -> dict[str, float]:
         ("Stop the car.", {"stop_request": 1.0}),
         ("Pull over and let me out.", {"stop_request": 2.0}),
         ("Don't go any further.", {"neg_continue": 1.0}),
+        # going on: a phrase, a verb, or a negated stop; negated it asks to stop
+        ("Keep going, but gently.", {"continue": 1.0, "slow": 1.0}),
+        ("You can go on, thanks.", {"continue": 1.0}),
+        ("No need to stop, just hurry.", {"continue": 1.0, "fast": 1.0}),
+        ("Please continue.", {"continue": 1.0}),
+        ("Don't carry on, pull over.", {"neg_continue": 1.0, "stop_request": 1.0}),
+        ("We can go on foot from here.", {"arrival": 1.0}),  # not "go on"
+        ("Let's go on the ring road.", {}),  # "go on" before a clause break only
         ("Not one more block.", {"neg_continue": 1.0}),
         # the negation ends at the clause break: "late" is a plain fast cue
         ("Don't take it so easy, we're late.", {"neg_slow": 1.0, "fast": 1.0}),

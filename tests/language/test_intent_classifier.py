@@ -12,6 +12,7 @@ from explaindrive.language.intent_classifier import (
     decide_rows,
     held_out_proba,
     select,
+    selection_cost,
     tune_none_margin,
     tune_stop_threshold,
 )
@@ -28,6 +29,18 @@ def test_stop_threshold_minimises_weighted_cost() -> None:
     assert tune_stop_threshold(np.array([0.3, 0.8, 0.2]), np.array([True, True, False])) == (
         pytest.approx(0.21)
     )
+
+
+def test_selection_cost_weighs_a_missed_stop_like_the_threshold() -> None:
+    # labels: 0 fast, 1 comfort, 2 stop, 3 none
+    y = np.array([0, 1, 2, 2, 3, 1])
+    # one comfort read as fast, one STOP missed (read as comfort): 2 errors, the miss
+    # weighing 5 -> 1 + 5 = 6
+    assert selection_cost(np.array([0, 0, 2, 1, 3, 1]), y) == pytest.approx(6.0)
+    # three errors, none of them a missed STOP (one false STOP, one dropped command, one
+    # off-topic request answered) -> 3: preferred to the candidate above
+    assert selection_cost(np.array([0, 2, 2, 2, 1, 3]), y) == pytest.approx(3.0)
+    assert selection_cost(y, y) == 0.0
 
 
 def test_decision_rule() -> None:

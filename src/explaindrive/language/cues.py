@@ -99,6 +99,19 @@ ARRIVAL_PHRASES: tuple[tuple[str, ...], ...] = (
     ("drop", "off"),
 )
 CONTINUE_WORDS = _words("further farther continue continuing anymore another beyond past")
+# Words and phrases that ask to go on driving (negated: "don't carry on" asks to stop).
+CONTINUE_VERBS = _words("continue continuing resume")
+CONTINUE_PHRASES: tuple[tuple[str, ...], ...] = (
+    ("keep", "going"),
+    ("keep", "driving"),
+    ("keep", "moving"),
+    ("keep", "on"),
+    ("carry", "on"),
+    ("press", "on"),
+    ("go", "on"),  # only before a clause break: not "go on foot", "go on the ring road"
+    ("drive", "on"),
+)
+_CLAUSE_FINAL_PHRASES = frozenset({("go", "on"), ("drive", "on")})
 NEGATORS = _words(
     """not no don't dont never needn't neednt isn't isnt aren't arent won't wont
     shouldn't cannot can't without quit too"""
@@ -193,6 +206,7 @@ CUE_NAMES: tuple[str, ...] = (
     "stop_destination",  # "this is my stop"
     "neg_continue",  # "no further", "don't continue", "not another block"
     "arrival",  # "we're here", "this will do", "right here is fine"
+    "continue",  # "keep going", "carry on", "you can go on", "no need to stop"
 )
 N_CUES = len(CUE_NAMES)
 _INDEX = {name: i for i, name in enumerate(CUE_NAMES)}
@@ -283,9 +297,16 @@ def cue_vector(text: str) -> NDArray[np.float32]:
             (FAST_PHRASES, "fast", "neg_fast"),
             (SLOW_PHRASES, "slow", "neg_slow"),
             (ARRIVAL_PHRASES, "arrival", "arrival"),
+            (CONTINUE_PHRASES, "continue", "neg_continue"),
         ):
             for phrase in phrases:
                 k = len(phrase)
+                if (
+                    phrase in _CLAUSE_FINAL_PHRASES
+                    and i + k < n
+                    and tokens[i + k] not in (_CLAUSE_BREAKS)
+                ):
+                    continue
                 if not any(consumed[i : i + k]) and tuple(tokens[i : i + k]) == phrase:
                     add(flipped if negated[i] else plain)
                     consumed[i : i + k] = [True] * k
@@ -302,7 +323,11 @@ def cue_vector(text: str) -> NDArray[np.float32]:
             add("too_fast")
         elif t in CONTINUE_WORDS and negated[i]:
             add("neg_continue")
-        if t in STOP_VERBS or t == "stops":
+        elif t in CONTINUE_VERBS:
+            add("continue")
+        if t in STOP_VERBS and negated[i] and i not in stop_role:
+            add("continue")  # "don't stop", "no need to stop", "without stopping"
+        elif t in STOP_VERBS or t == "stops":
             role = stop_role.get(i, "noun" if t == "stops" else "request")
             if role in ("request", "noun", "destination"):
                 add(f"stop_{role}" if role != "request" else "stop_request")

@@ -39,15 +39,23 @@ DEV4_CSV = "commands_dev4.csv"
 """Fourth development split (a former test split, evaluated once)."""
 DEV5_CSV = "commands_dev5.csv"
 """Fifth development split (a former test split, evaluated once)."""
-DEV_SPLITS: tuple[str, ...] = (DEV_CSV, DEV2_CSV, DEV3_CSV, DEV4_CSV, DEV5_CSV)
+DEV6_CSV = "commands_dev6.csv"
+"""Sixth development split (the round-6 test split, evaluated by the round-6 model)."""
+DEV7_CSV = "commands_dev7.csv"
+"""Seventh development split (the round-7 test split, evaluated by the round-6 model)."""
+DEV_SPLITS: tuple[str, ...] = (
+    DEV_CSV,
+    DEV2_CSV,
+    DEV3_CSV,
+    DEV4_CSV,
+    DEV5_CSV,
+    DEV6_CSV,
+    DEV7_CSV,
+)
 """The development splits, each written in its own round; LLM-1 selection holds each out."""
-TEST_CSV = "commands_test.csv"
-"""Held-out requests, written before the shipped model and never used to build it."""
-TEST2_CSV = "commands_test2.csv"
-"""A second held-out split, written after the shipped model was built."""
-TEST3_CSV = "commands_test3.csv"
-"""A third held-out split (round 8), written before the next model was built."""
-TEST_SPLITS: tuple[str, ...] = (TEST_CSV, TEST2_CSV, TEST3_CSV)
+TEST_CSV = "commands_test3.csv"
+"""Held-out requests (round 8), written before the shipped model and never used to build it."""
+TEST_SPLITS: tuple[str, ...] = (TEST_CSV,)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 

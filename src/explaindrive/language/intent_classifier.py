@@ -340,19 +340,26 @@ def held_out_knn_proba(train: Encoded, devs: list[Encoded]) -> NDArray[np.float6
     return np.vstack(out)
 
 
+def selection_cost(pred: NDArray[np.int64], y: NDArray[np.int64]) -> float:
+    """Errors of a candidate, a missed STOP weighing ``STOP_MISS_COST`` errors (as in the
+    STOP threshold's own cost) and any other error one."""
+    missed_stops = np.sum((y == STOP) & (pred != STOP))
+    return float(np.sum(pred != y) + (STOP_MISS_COST - 1.0) * missed_stops)
+
+
 def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...]]) -> Selection:
-    """Pick the hyper-parameters with the best accuracy on held-out development splits.
+    """Pick the hyper-parameters with the fewest errors on held-out development splits.
 
     Each development split is predicted by a model fitted on the training requests and
     the other development splits (leave one split out), so every split is judged by a
     model that never saw it and was written in another round. For each candidate the
     STOP threshold is tuned on the pooled held-out probabilities
-    (:func:`tune_stop_threshold`); the candidate with the highest pooled accuracy at its
-    threshold wins (ties: fewer false STOPs, then earlier in the grid).
+    (:func:`tune_stop_threshold`); the candidate with the lowest :func:`selection_cost` at
+    its threshold wins (ties: fewer false STOPs, then earlier in the grid).
     """
     y = np.concatenate([d.y for d in devs])
     p_knn = held_out_knn_proba(train, devs)  # depends on the embeddings only
-    best: tuple[float, int, Selection] | None = None
+    best: tuple[float, int, Selection] | None = None  # (cost, false STOPs, selection)
     for c, ngram_w, cue_w in itertools.product(grid["c"], grid["ngram_weight"], grid["cue_weight"]):
         spec = FeatureSpec(ngram_weight=ngram_w, cue_weight=cue_w)
         # the logistic regression does not depend on the blend: fit once, blend after
@@ -366,9 +373,10 @@ def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...
             acc = float(np.mean(pred == y))
             false_stops = int(np.sum((pred == STOP) & (y != STOP)))
             recall = float(np.mean(pred[y == STOP] == STOP))
+            cost = selection_cost(pred, y)
             log.info(
                 "C=%g ngram=%g cue=%g lr=%g: held-out accuracy %.3f, STOP threshold %.2f "
-                "(recall %.3f, false STOPs %d), none margin %.2f",
+                "(recall %.3f, false STOPs %d), none margin %.2f, cost %g",
                 c,
                 ngram_w,
                 cue_w,
@@ -378,9 +386,10 @@ def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...
                 recall,
                 false_stops,
                 m,
+                cost,
             )
-            if best is None or (acc, -false_stops) > (best[0], best[1]):
-                best = (acc, -false_stops, Selection(hyper, acc, t, m, recall, false_stops))
+            if best is None or (cost, false_stops) < (best[0], best[1]):
+                best = (cost, false_stops, Selection(hyper, acc, t, m, recall, false_stops))
     assert best is not None
     return best[2]
 
