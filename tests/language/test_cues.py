@@ -28,6 +28,11 @@ def cues(text: str) -> dict[str, float]:
         ("That stop was too abrupt.", {"stop_noun": 1.0, "too_fast": 1.0}),
         ("This is my stop.", {"stop_destination": 1.0}),
         ("Stop the car.", {"stop_request": 1.0}),
+        # a motion verb after "stop" halts the car, unless a manner follows
+        ("Cease moving immediately.", {"stop_request": 1.0}),
+        ("Stop driving, please.", {"stop_request": 1.0}),
+        ("Stop driving like a maniac.", {"too_fast": 1.0}),
+        ("Cease tailgating.", {"too_fast": 1.0}),
         ("Pull over and let me out.", {"stop_request": 2.0}),
         ("Don't go any further.", {"neg_continue": 1.0}),
         # going on: a phrase, a verb, or a negated stop; negated it asks to stop
@@ -42,6 +47,14 @@ def cues(text: str) -> dict[str, float]:
         # the negation ends at the clause break: "late" is a plain fast cue
         ("Don't take it so easy, we're late.", {"neg_slow": 1.0, "fast": 1.0}),
         ("Play some music.", {}),
+        # speeds as numbers: a cap is slower, a floor faster, "X in a Y" compares them
+        ("Drop us down to about forty, please.", {"slow": 1.0}),
+        ("Keep it under 30 mph.", {"slow": 1.0}),
+        ("Never exceed 20 mph.", {"slow": 1.0}),  # "never" negates "exceed"
+        ("Get it up to 70 on the motorway.", {"fast": 1.0}),
+        ("Stop doing fifty in a thirty zone.", {"too_fast": 1.0}),
+        ("We're doing 20 in a 50 limit!", {"too_slow": 1.0}),
+        ("I have 2 kids.", {}),
         # idioms
         ("What's the rush?", {"neg_fast": 1.0}),
         ("Hold your horses, we have time.", {"slow": 1.0}),

@@ -57,7 +57,10 @@ TOO_FAST_WORDS = _words(
     racetrack speedway daredevil kamikaze lurching lurch jolting jolt"""
 )
 # Requests to stop the trip, and words of continuing (negated: "no further").
-STOP_VERBS = _words("stop halt park stopping")
+STOP_VERBS = _words("stop halt park stopping cease")
+# "stop moving" halts the car, unless a manner follows ("stop driving like a maniac").
+_MOTION_GERUNDS = _words("moving driving going rolling travelling traveling")
+_HALT_FOLLOWERS = _words("now immediately instantly here please right asap")
 # Common words that look like cue words with a typo but are not ("speed" is neutral).
 _NOT_TYPOS = _words("speed speeds sped waving wave slot slots later showing")
 STOP_PHRASES: tuple[tuple[str, ...], ...] = (
@@ -191,7 +194,7 @@ NEEDLESS_PACE_PHRASES: tuple[tuple[str, ...], ...] = (
 _LEXICON: tuple[str, ...] = tuple(
     sorted(FAST_WORDS | SLOW_WORDS | TOO_SLOW_WORDS | TOO_FAST_WORDS | STOP_VERBS | {"stops"})
 )
-_TOKEN_RE = re.compile(r"[a-z']+|[.,!?;:]")
+_TOKEN_RE = re.compile(r"[a-z']+|\d+|[.,!?;:]")
 _CLAUSE_BREAKS = frozenset(".,!?;:") | {"but", "and", "because"}
 
 CUE_NAMES: tuple[str, ...] = (
@@ -258,6 +261,50 @@ def _in_scope(tokens: list[str], negated: list[bool], start: int) -> None:
         negated[j] = True
 
 
+# Speeds given as numbers: a cap asks for less speed, a floor for more.
+_NUMBER_WORDS = {
+    "ten": 10, "fifteen": 15, "twenty": 20, "thirty": 30, "forty": 40, "fifty": 50,
+    "sixty": 60, "seventy": 70, "eighty": 80, "ninety": 90, "hundred": 100,
+}  # fmt: skip
+_CAP_WORDS = _words("under below beneath max maximum")  # "keep it under 30"
+_OVER_WORDS = _words("over above exceed exceeding past beyond")  # negated: a cap
+_FLOOR_PHRASES: tuple[tuple[str, ...], ...] = (("at", "least"), ("up", "to"))
+_DOWN_PHRASES: tuple[tuple[str, ...], ...] = (("down", "to"), ("drop", "to"), ("back", "to"))
+_APPROXIMATELY = _words("about around roughly approximately maybe say")  # "down to about 40"
+
+
+def _number(token: str) -> int | None:
+    if token.isdigit():
+        return int(token)
+    return _NUMBER_WORDS.get(token)
+
+
+def speed_number_cues(tokens: list[str], negated: list[bool]) -> list[str]:
+    """Cues from speeds given as numbers.
+
+    "under 30", "down to forty", "don't go over 50" -> ``slow``; "at least 60", "up to
+    seventy" -> ``fast``; "fifty in a thirty" -> ``too_fast`` (``too_slow`` the other way).
+    """
+    out: list[str] = []
+    n = len(tokens)
+    for i, t in enumerate(tokens):
+        value = _number(t)
+        if value is None:
+            continue
+        j = i - 1 if i > 0 and tokens[i - 1] in _APPROXIMATELY else i  # the number's start
+        prev = tokens[j - 1] if j > 0 else ""
+        pair = tuple(tokens[j - 2 : j]) if j >= 2 else ()
+        if prev in _CAP_WORDS or pair in _DOWN_PHRASES or (prev in _OVER_WORDS and negated[j - 1]):
+            out.append("slow")
+        elif pair in _FLOOR_PHRASES:
+            out.append("fast")
+        if i + 3 < n and tokens[i + 1 : i + 3] == ["in", "a"]:
+            limit = _number(tokens[i + 3])
+            if limit is not None and limit != value:
+                out.append("too_fast" if value > limit else "too_slow")
+    return out
+
+
 def cue_vector(text: str) -> NDArray[np.float32]:
     """Counts of each cue in :data:`CUE_NAMES` for one request (each capped at 2)."""
     raw = tokenize(text)
@@ -278,7 +325,13 @@ def cue_vector(text: str) -> NDArray[np.float32]:
         prev = tokens[i - 1] if i > 0 else ""
         if t in NEGATORS or (t == "need" and prev == "no"):
             _in_scope(tokens, negated, i)
-        elif t in ("stop", "quit") and (_is_gerund(nxt) or nxt == "being"):
+        elif (
+            t in ("stop", "quit", "cease")
+            and nxt in _MOTION_GERUNDS
+            and (i + 2 >= n or tokens[i + 2] in _CLAUSE_BREAKS or tokens[i + 2] in _HALT_FOLLOWERS)
+        ):
+            stop_role[i] = "request"  # "stop moving now", "cease driving."
+        elif t in ("stop", "quit", "cease") and (_is_gerund(nxt) or nxt == "being"):
             stop_role[i] = "negator"  # "stop speeding" = do not speed
             _in_scope(tokens, negated, i)
         elif t == "stop" and prev in _POSSESSIVES:
@@ -304,7 +357,7 @@ def cue_vector(text: str) -> NDArray[np.float32]:
                 if (
                     phrase in _CLAUSE_FINAL_PHRASES
                     and i + k < n
-                    and tokens[i + k] not in (_CLAUSE_BREAKS)
+                    and tokens[i + k] not in _CLAUSE_BREAKS
                 ):
                     continue
                 if not any(consumed[i : i + k]) and tuple(tokens[i : i + k]) == phrase:
@@ -334,6 +387,8 @@ def cue_vector(text: str) -> NDArray[np.float32]:
         for phrase in STOP_PHRASES:
             if tuple(tokens[i : i + len(phrase)]) == phrase:
                 add("stop_request")
+    for name in speed_number_cues(tokens, negated):
+        add(name)
     # "not one more meter", "not another inch": a negated quantity of further driving
     if n >= 2 and tokens[0] in ("not", "no") and tokens[1] in ("one", "another", "a", "further"):
         add("neg_continue")
