@@ -7,9 +7,10 @@ when it falls in the scope of a negator ("don't", "no need to", "too", "stop"/"q
 before a gerund). Cue words are matched with a small edit tolerance so that typed or
 transcribed typos ("slowr", "fastr") still count.
 
-Common idioms of pace ("chop chop", "hold your horses", "what's the rush?") and of
-arrival ("this will do", "we're here") count as phrases, and chat spellings ("ez",
-"to fast" for "too fast") are read as the words they stand for.
+Common idioms of pace ("chop chop", "hold your horses", "what's the rush?"), of arrival
+("this will do", "we're here") and of going on ("keep going", "carry on") count as
+phrases, chat spellings ("ez", "to fast" for "too fast") are read as the words they stand
+for, and speeds given as numbers count as a direction ("under 30", "fifty in a thirty").
 
 The features are general (word classes, negation scope, the part of speech of "stop",
 idioms of English); they are combined with the sentence embedding and weighted by the
