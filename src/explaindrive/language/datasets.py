@@ -45,6 +45,8 @@ DEV7_CSV = "commands_dev7.csv"
 """Seventh development split (the round-7 test split, evaluated by the round-6 model)."""
 DEV8_CSV = "commands_dev8.csv"
 """Eighth development split (the round-8 test split, evaluated by the round-8 model)."""
+DEV9_CSV = "commands_dev9.csv"
+"""Ninth development split (the round-9 test split, evaluated by the round-9 model)."""
 DEV_SPLITS: tuple[str, ...] = (
     DEV_CSV,
     DEV2_CSV,
@@ -54,10 +56,11 @@ DEV_SPLITS: tuple[str, ...] = (
     DEV6_CSV,
     DEV7_CSV,
     DEV8_CSV,
+    DEV9_CSV,
 )
 """The development splits, each written in its own round; LLM-1 selection holds each out."""
-TEST_CSV = "commands_test4.csv"
-"""Held-out requests (round 9), written before the shipped model and never used to build it."""
+TEST_CSV = "commands_test5.csv"
+"""Held-out requests (round 10), written before the shipped model and never used to build it."""
 TEST_SPLITS: tuple[str, ...] = (TEST_CSV,)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
