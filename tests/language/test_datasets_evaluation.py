@@ -123,3 +123,8 @@ def test_config_rejects_unknown_keys(tmp_path) -> None:  # type: ignore[no-untyp
         LanguageConfig.from_yaml(p)
     p.write_text("openai:\n  timeout_s: 0.5\n")
     assert LanguageConfig.from_yaml(p).openai.timeout_s == 0.5
+    p.write_text("embedded:\n  encoder: bert\n")
+    with pytest.raises(ValueError, match="encoder"):
+        LanguageConfig.from_yaml(p)
+    p.write_text("embedded:\n  encoder: mpnet\n")
+    assert LanguageConfig.from_yaml(p).embedded.encoder == "mpnet"

@@ -8,6 +8,8 @@ from typing import Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
+from explaindrive.language.encoders import EncoderName
+
 BackendName = Literal["embedded", "openai"]
 
 SUMMARY_CUTOFF_M = 50.0  # [m] objects farther than this are left out of summaries and decisions
@@ -37,10 +39,14 @@ class SpeechConfig(_Strict):
 class EmbeddedConfig(_Strict):
     """Offline backend: sentence embeddings + shipped classifier, rule engine, templates."""
 
+    encoder: EncoderName = "minilm"
+    """Sentence encoder of LLM-1: ``minilm`` (all-MiniLM-L6-v2, default) or ``mpnet``
+    (all-mpnet-base-v2, the ``mpnet`` extra: fewer errors, about five times slower)."""
     embedding_model_dir: Path | None = None
-    """sentence-transformers model directory; ``None`` = all-MiniLM-L6-v2 from its package."""
+    """sentence-transformers model directory; ``None`` = the encoder's packaged model."""
     classifier_path: Path | None = None
-    """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data``."""
+    """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data`` for
+    ``encoder``."""
     stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
     """STOP wins whenever its probability reaches this; ``None`` = the value stored with the
     weights (tuned on the held-out development splits)."""

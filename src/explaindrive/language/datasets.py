@@ -64,6 +64,12 @@ TEST_CSV = "commands_test5.csv"
 TEST_SPLITS: tuple[str, ...] = (TEST_CSV,)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
+"""The shipped LLM-1 weights over the default encoder (MiniLM)."""
+CLASSIFIER_FILES: dict[str, str] = {
+    "minilm": CLASSIFIER_NPZ,
+    "mpnet": "intent_classifier_mpnet.npz",
+}
+"""The shipped LLM-1 weights per sentence encoder."""
 
 
 @dataclass(frozen=True, slots=True)

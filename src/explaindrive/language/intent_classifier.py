@@ -15,7 +15,8 @@ off-topic only when its off-topic probability leads the best command's by more t
 ``COMMAND_DROP_COST`` off-topic requests answered with a confirmation question. Retrain
 and re-ship the weights with::
 
-    python -m explaindrive.language.intent_classifier
+    python -m explaindrive.language.intent_classifier                   # MiniLM (default)
+    python -m explaindrive.language.intent_classifier --encoder mpnet   # the mpnet extra
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from numpy.typing import NDArray
 from sklearn.linear_model import LogisticRegression
 
 from explaindrive.language.datasets import (
-    CLASSIFIER_NPZ,
+    CLASSIFIER_FILES,
     DEV_SPLITS,
     INTENT_LABELS,
     TRAIN_CSV,
@@ -40,6 +41,7 @@ from explaindrive.language.datasets import (
     data_path,
     load_commands,
 )
+from explaindrive.language.encoders import ENCODERS, check_encoder
 from explaindrive.language.features import (
     FeatureSpec,
     SentenceEncoder,
@@ -145,18 +147,20 @@ class IntentClassifier:
             ngram_weight=self.spec.ngram_weight,
             cue_weight=self.spec.cue_weight,
             n_cues=self.spec.n_cues,
+            encoder=self.spec.encoder,
             lr_weight=self.lr_weight,
         )
 
     @classmethod
-    def load(cls, path: str | Path | None = None) -> IntentClassifier:
-        """Read weights (default: the shipped ones).
+    def load(cls, path: str | Path | None = None, encoder: str = "minilm") -> IntentClassifier:
+        """Read weights (default: the ones shipped for ``encoder``).
 
         Raises:
             FileNotFoundError: if the file is missing.
-            ValueError: if it is not a classifier written by :meth:`save`.
+            ValueError: if it is not a classifier written by :meth:`save`, or was built
+                over another encoder's embeddings than ``encoder``.
         """
-        p = Path(path) if path is not None else data_path(CLASSIFIER_NPZ)
+        p = Path(path) if path is not None else data_path(CLASSIFIER_FILES[check_encoder(encoder)])
         if not p.is_file():
             raise FileNotFoundError(f"intent classifier weights not found: {p}")
         try:
@@ -174,6 +178,7 @@ class IntentClassifier:
                         float(z["ngram_weight"]),
                         float(z["cue_weight"]),
                         int(z["n_cues"]),
+                        str(z["encoder"]) if "encoder" in z.files else "minilm",
                     ),
                     lr_weight=float(z["lr_weight"]),
                 )
@@ -181,6 +186,12 @@ class IntentClassifier:
             raise ValueError(f"{p}: not a valid intent classifier file ({exc})") from exc
         if labels != INTENT_LABELS:
             raise ValueError(f"{p}: labels {labels} differ from {INTENT_LABELS}")
+        if clf.spec.encoder != encoder:
+            raise ValueError(
+                f"{p}: built over the {clf.spec.encoder!r} encoder's embeddings, not {encoder!r}; "
+                "use the matching encoder or rebuild with `python -m "
+                f"explaindrive.language.intent_classifier --encoder {encoder}`"
+            )
         return clf
 
 
@@ -394,10 +405,15 @@ def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...
     return best[2]
 
 
-def fit_final(train: Encoded, devs: list[Encoded], sel: Selection) -> IntentClassifier:
-    """Fit the shipped model on the training and all development requests."""
+def fit_final(
+    train: Encoded, devs: list[Encoded], sel: Selection, encoder: str = "minilm"
+) -> IntentClassifier:
+    """Fit the shipped model on the training and all development requests (embedded by
+    ``encoder``)."""
     hyper = sel.hyper
-    spec = FeatureSpec(ngram_weight=hyper.ngram_weight, cue_weight=hyper.cue_weight)
+    spec = FeatureSpec(
+        ngram_weight=hyper.ngram_weight, cue_weight=hyper.cue_weight, encoder=encoder
+    )
     pool = Encoded.concat([train, *devs])
     x = pool.features(spec)
     dim = train.emb.shape[1]
@@ -428,7 +444,7 @@ def train(
         sel.false_stops,
         sel.none_margin,
     )
-    return fit_final(tr, devs, sel), sel
+    return fit_final(tr, devs, sel, encoder.name), sel
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -442,16 +458,22 @@ def main(argv: list[str] | None = None) -> None:
         default=[data_path(n) for n in DEV_SPLITS],
         help="development splits (at least two; each is held out in turn)",
     )
-    parser.add_argument("--out", type=Path, default=data_path(CLASSIFIER_NPZ))
+    parser.add_argument(
+        "--encoder", choices=ENCODERS, default="minilm", help="sentence encoder (default minilm)"
+    )
+    parser.add_argument(
+        "--out", type=Path, default=None, help="weights file (default: the shipped one)"
+    )
     args = parser.parse_args(argv)
+    out = args.out or data_path(CLASSIFIER_FILES[args.encoder])
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     train_rows = load_commands(args.train)
     dev_rows = [load_commands(p) for p in args.dev]
-    clf, _ = train(train_rows, dev_rows, SentenceEncoder())
-    clf.save(args.out)
+    clf, _ = train(train_rows, dev_rows, SentenceEncoder(name=args.encoder))
+    clf.save(out)
     log.info(
         "wrote %s (%d training + %d development requests)",
-        args.out,
+        out,
         len(train_rows),
         sum(map(len, dev_rows)),
     )

@@ -26,7 +26,7 @@ NAME = "embedded"
 
 
 class EmbeddedIntentInterpreter(IntentInterpreter):
-    """LLM-1 offline: all-MiniLM-L6-v2 features + the shipped classifier."""
+    """LLM-1 offline: sentence-encoder features + the classifier shipped for that encoder."""
 
     name = NAME
 
@@ -36,9 +36,9 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         """Args: config: backend options; encoder: share one loaded encoder between users."""
         self.config = config or EmbeddedConfig()
         self.encoder = encoder or SentenceEncoder(
-            self.config.embedding_model_dir, self.config.encoder_threads
+            self.config.embedding_model_dir, self.config.encoder_threads, self.config.encoder
         )
-        self.classifier = IntentClassifier.load(self.config.classifier_path)
+        self.classifier = IntentClassifier.load(self.config.classifier_path, self.encoder.name)
 
     def load(self) -> None:
         """Load the sentence encoder now rather than on the first request."""
