@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_language.py [--backend embedded|openai] [--n 200]
+    python benchmarks/bench_language.py [--backend embedded|openai] [--n 200] [--encoder mpnet]
 
 Prints p50/p95 latencies [ms] after model load and Whisper tiny.en's real-time factor
 on espeak-ng speech (skipped when espeak-ng is missing). Targets on 2 cores: embedded
@@ -22,6 +22,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from explaindrive.language.config import EmbeddedConfig, LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
     DEV_CSV,
@@ -29,6 +30,7 @@ from explaindrive.language.datasets import (
     load_commands,
     load_decisions,
 )
+from explaindrive.language.encoders import ENCODERS
 from explaindrive.language.stack import make_language_stack
 
 SENTENCES = (
@@ -48,9 +50,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description="language-layer latency benchmark")
     parser.add_argument("--backend", default="embedded", choices=("embedded", "openai"))
     parser.add_argument("--n", type=int, default=200, help="requests / records timed")
+    parser.add_argument("--encoder", default="minilm", choices=ENCODERS, help="LLM-1 encoder")
     args = parser.parse_args()
     console = Console()
-    stack = make_language_stack(args.backend)
+    config = LanguageConfig(embedded=EmbeddedConfig(encoder=args.encoder))
+    stack = make_language_stack(args.backend, config)
     t0 = time.perf_counter()
     stack.interpreter.interpret("warm up")  # loads the encoder
     load_s = time.perf_counter() - t0
@@ -72,7 +76,10 @@ def main() -> None:
             stack.explainer.explain(rec, d.factor)
         lat_de.append(time.perf_counter() - t)
 
-    table = Table(title=f"language layer, backend {args.backend} (load {load_s:.1f} s)")
+    table = Table(
+        title=f"language layer, backend {args.backend}, encoder {args.encoder} "
+        f"(load {load_s:.1f} s)"
+    )
     for col in ("call", "n", "p50 [ms]", "p95 [ms]"):
         table.add_column(col, justify="right")
     for name, lat in (("interpret", lat_i), ("decide", lat_d), ("decide+explain", lat_de)):

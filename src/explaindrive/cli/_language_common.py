@@ -10,20 +10,26 @@ import typer
 from rich.console import Console
 
 from explaindrive.language.config import LanguageConfig
+from explaindrive.language.encoders import check_encoder
 
 console = Console()
 err_console = Console(stderr=True)
 
 BACKEND_HELP = "Language backend: embedded (offline, default) or openai."
 CONFIG_HELP = "YAML language config (see docs/language.md)."
+ENCODER_HELP = "LLM-1 sentence encoder of the embedded backend: minilm (default) or mpnet."
 
 
-def load_config(path: Path | None) -> LanguageConfig:
-    """The language config from ``path`` or the defaults; exits with a message on errors."""
-    if path is None:
-        return LanguageConfig()
+def load_config(path: Path | None, encoder: str | None = None) -> LanguageConfig:
+    """The language config from ``path`` or the defaults, with ``encoder`` (if given)
+    replacing ``embedded.encoder``; exits with a message on errors."""
     try:
-        return LanguageConfig.from_yaml(path)
+        config = LanguageConfig() if path is None else LanguageConfig.from_yaml(path)
+        if encoder is None:
+            return config
+        raw = config.model_dump()
+        raw["embedded"]["encoder"] = check_encoder(encoder)
+        return LanguageConfig.model_validate(raw)
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
 
