@@ -47,6 +47,8 @@ DEV8_CSV = "commands_dev8.csv"
 """Eighth development split (the round-8 test split, evaluated by the round-8 model)."""
 DEV9_CSV = "commands_dev9.csv"
 """Ninth development split (the round-9 test split, evaluated by the round-9 model)."""
+DEV10_CSV = "commands_dev10.csv"
+"""Tenth development split (the round-10 test split, evaluated by the round-10 model)."""
 DEV_SPLITS: tuple[str, ...] = (
     DEV_CSV,
     DEV2_CSV,
@@ -57,10 +59,12 @@ DEV_SPLITS: tuple[str, ...] = (
     DEV7_CSV,
     DEV8_CSV,
     DEV9_CSV,
+    DEV10_CSV,
 )
 """The development splits, each written in its own round; LLM-1 selection holds each out."""
-TEST_CSV = "commands_test5.csv"
-"""Held-out requests (round 10), written before the shipped model and never used to build it."""
+TEST_CSV = "commands_test6.csv"
+"""Held-out requests (round 11), written before the shipped models and never used to build
+them."""
 TEST_SPLITS: tuple[str, ...] = (TEST_CSV,)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
