@@ -8,7 +8,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from explaindrive.ride.config import RideConfig
-from explaindrive.web import create_app
+from explaindrive.web import RealStack, create_app
 
 from .conftest import STEP_PERIOD_S, fake_session_factory, wait_for, wait_status
 
@@ -248,3 +248,11 @@ def test_a_ride_that_cannot_start():
         assert res.status_code == 200
         assert calls[1].realtime and calls[1].traffic_level == 0.5 and calls[1].seed == 3
         client.post("/api/ride/reset")
+
+
+def test_real_stack_checks_backend_and_encoder() -> None:
+    with pytest.raises(ValueError, match="backend must be"):
+        RealStack("gpt9")
+    with pytest.raises(ValueError, match="unknown sentence encoder 'bert'"):
+        RealStack("embedded", "bert")
+    assert RealStack("embedded", "mpnet").encoder == "mpnet"  # models load on the first ride

@@ -12,6 +12,7 @@ import typer
 from rich.console import Console
 from rich.live import Live
 
+from explaindrive.cli._language_common import ENCODER_HELP
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.script import AUDIO_PREFIX, ScriptError, default_script_path, load_script
 
@@ -31,6 +32,7 @@ def ride(
     backend: str = typer.Option(
         "embedded", "--backend", help="Language backend: embedded or openai."
     ),
+    encoder: str = typer.Option("minilm", "--encoder", help=ENCODER_HELP),
     traffic: float = typer.Option(1.0, "--traffic", help="Traffic level (1.0 = 900 veh/h)."),
     seed: int = typer.Option(0, "--seed", help="Simulation seed."),
     gui: bool = typer.Option(False, "--gui", help="Show the ride in sumo-gui."),
@@ -49,6 +51,8 @@ def ride(
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.controller import MergedController
+    from explaindrive.language.config import EmbeddedConfig, LanguageConfig
+    from explaindrive.language.encoders import check_encoder
     from explaindrive.language.stack import make_language_stack
     from explaindrive.ride.runner import run_ride
     from explaindrive.ride.session import RideSession
@@ -72,6 +76,7 @@ def ride(
             else load_script(script or default_script_path(), max_time_s=float(max_steps))
         )
         controller = MergedController.from_package()
+        language_config = LanguageConfig(embedded=EmbeddedConfig(encoder=check_encoder(encoder)))
     except (ValueError, ScriptError, CheckpointError) as exc:
         console.print(f"[red]error:[/red] {exc}")
         raise typer.Exit(2) from exc
@@ -82,7 +87,8 @@ def ride(
     if interactive:
         typed = queue.Queue()
         _start_input_thread(typed, voice)
-    language = make_language_stack(backend).load(speech=voice or any(ln.audio for ln in lines))
+    speech = voice or any(ln.audio for ln in lines)
+    language = make_language_stack(backend, language_config).load(speech=speech)
     session = RideSession(config, controller, language)
     if script is None and not interactive:
         console.print(f"default ride script: {default_script_path()}")

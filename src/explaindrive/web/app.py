@@ -27,6 +27,7 @@ from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from starlette.datastructures import UploadFile
 
+from explaindrive.language.encoders import check_encoder
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.sim.scenario.files import default_scenario
@@ -55,12 +56,14 @@ class RealStack:
 
     Args:
         backend: language backend, ``embedded`` or ``openai``.
+        encoder: LLM-1 sentence encoder of the embedded backend (``minilm`` or ``mpnet``).
     """
 
-    def __init__(self, backend: str = "embedded") -> None:
+    def __init__(self, backend: str = "embedded", encoder: str = "minilm") -> None:
         if backend not in ("embedded", "openai"):
             raise ValueError(f"backend must be 'embedded' or 'openai', got {backend!r}")
         self.backend = backend
+        self.encoder = check_encoder(encoder)
         self._controller: Any = None
         self._language: Any = None
 
@@ -69,12 +72,14 @@ class RealStack:
         from dataclasses import replace
 
         from explaindrive.agent.controller import MergedController
+        from explaindrive.language.config import EmbeddedConfig, LanguageConfig
         from explaindrive.language.stack import make_language_stack
 
         if self._controller is None:
             self._controller = MergedController.from_package()
         if self._language is None:
-            self._language = make_language_stack(self.backend).load()
+            language_config = LanguageConfig(embedded=EmbeddedConfig(encoder=self.encoder))
+            self._language = make_language_stack(self.backend, language_config).load()
         return RideSession(replace(config, backend=self.backend), self._controller, self._language)
 
 
@@ -82,6 +87,7 @@ def create_app(
     session_factory: SessionFactory | None = None,
     *,
     backend: str = "embedded",
+    encoder: str = "minilm",
     step_period_s: float = 1.0,
     max_upload_bytes: int = MAX_UPLOAD_BYTES,
 ) -> FastAPI:
@@ -91,10 +97,11 @@ def create_app(
         session_factory: builds a ride session from its settings; the real stack
             (:class:`RealStack` with ``backend``) when omitted. Tests inject fakes here.
         backend: language backend of the default factory.
+        encoder: LLM-1 sentence encoder of the default factory's embedded backend.
         step_period_s: wall time per 1 s control step [s]; 1.0 rides in real time.
         max_upload_bytes: largest accepted audio upload [B].
     """
-    factory = session_factory or RealStack(backend)
+    factory = session_factory or RealStack(backend, encoder)
     scene = load_scene(default_scenario().net_file)
     manager = RideManager(factory, scene, step_period_s=step_period_s)
 
