@@ -62,10 +62,13 @@ DEV_SPLITS: tuple[str, ...] = (
     DEV10_CSV,
 )
 """The development splits, each written in its own round; LLM-1 selection holds each out."""
-TEST_CSV = "commands_test6.csv"
-"""Held-out requests (round 11), written before the shipped models and never used to build
-them."""
-TEST_SPLITS: tuple[str, ...] = (TEST_CSV,)
+TEST6_CSV = "commands_test6.csv"
+"""Held-out requests of round 11, written before the shipped MiniLM and mpnet models and
+evaluated once by each; never used to build them."""
+TEST_CSV = "commands_test7.csv"
+"""Held-out requests of round 12, written before the shipped cascade rule and never used to
+build any shipped model."""
+TEST_SPLITS: tuple[str, ...] = (TEST6_CSV, TEST_CSV)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 """The shipped LLM-1 weights over the default encoder (MiniLM)."""
@@ -74,6 +77,8 @@ CLASSIFIER_FILES: dict[str, str] = {
     "mpnet": "intent_classifier_mpnet.npz",
 }
 """The shipped LLM-1 weights per sentence encoder."""
+CASCADE_JSON = "intent_cascade.json"
+"""When the LLM-1 cascade hands a request from the MiniLM to the mpnet model."""
 
 
 @dataclass(frozen=True, slots=True)
