@@ -123,8 +123,11 @@ def test_config_rejects_unknown_keys(tmp_path) -> None:  # type: ignore[no-untyp
         LanguageConfig.from_yaml(p)
     p.write_text("openai:\n  timeout_s: 0.5\n")
     assert LanguageConfig.from_yaml(p).openai.timeout_s == 0.5
-    p.write_text("embedded:\n  encoder: bert\n")
-    with pytest.raises(ValueError, match="encoder"):
+    p.write_text("embedded:\n  intent_model: bert\n")
+    with pytest.raises(ValueError, match="intent_model"):
         LanguageConfig.from_yaml(p)
-    p.write_text("embedded:\n  encoder: mpnet\n")
-    assert LanguageConfig.from_yaml(p).embedded.encoder == "mpnet"
+    p.write_text("embedded:\n  classifier_path: my.npz\n")  # the cascade has two models
+    with pytest.raises(ValueError, match="need intent_model minilm or mpnet"):
+        LanguageConfig.from_yaml(p)
+    p.write_text("embedded:\n  intent_model: mpnet\n  escalation_margin: 0.2\n")
+    assert LanguageConfig.from_yaml(p).embedded.intent_model == "mpnet"

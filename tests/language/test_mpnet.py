@@ -1,4 +1,4 @@
-"""LLM-1 over all-mpnet-base-v2 (the ``mpnet`` extra, installed with the dev extra)."""
+"""LLM-1 over all-mpnet-base-v2 alone (``intent_model: mpnet``)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from explaindrive.ride.script import default_script_path, load_script
 
 @pytest.fixture(scope="module")
 def mpnet() -> EmbeddedIntentInterpreter:
-    it = EmbeddedIntentInterpreter(EmbeddedConfig(encoder="mpnet"))
+    it = EmbeddedIntentInterpreter(EmbeddedConfig(intent_model="mpnet"))
     it.load()
     return it
 

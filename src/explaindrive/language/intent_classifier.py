@@ -320,6 +320,9 @@ class Selection:
     none_margin: float  # cost-tuned on the pooled held-out probabilities
     stop_recall: float
     false_stops: int
+    cost: float  # :func:`selection_cost` of the pooled held-out predictions
+    proba: NDArray[np.float64] = field(repr=False)
+    """Pooled held-out probabilities of the development requests (rows in split order)."""
 
 
 def held_out_proba(
@@ -400,7 +403,11 @@ def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...
                 cost,
             )
             if best is None or (cost, false_stops) < (best[0], best[1]):
-                best = (cost, false_stops, Selection(hyper, acc, t, m, recall, false_stops))
+                best = (
+                    cost,
+                    false_stops,
+                    Selection(hyper, acc, t, m, recall, false_stops, cost, p),
+                )
     assert best is not None
     return best[2]
 
