@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_language.py [--backend embedded|openai] [--n 200]
-        [--intent-model cascade|minilm|mpnet]
+        [--encoder mpnet|minilm]
 
 Prints p50/p95 latencies [ms] after model load and Whisper tiny.en's real-time factor
 on espeak-ng speech (skipped when espeak-ng is missing). Targets on 2 cores: embedded
@@ -31,7 +31,7 @@ from explaindrive.language.datasets import (
     load_commands,
     load_decisions,
 )
-from explaindrive.language.encoders import INTENT_MODELS
+from explaindrive.language.encoders import DEFAULT_ENCODER, ENCODERS
 from explaindrive.language.stack import make_language_stack
 
 SENTENCES = (
@@ -52,27 +52,23 @@ def main() -> None:
     parser.add_argument("--backend", default="embedded", choices=("embedded", "openai"))
     parser.add_argument("--n", type=int, default=200, help="requests / records timed")
     parser.add_argument(
-        "--intent-model", default="cascade", choices=INTENT_MODELS, help="LLM-1 model"
+        "--encoder", default=DEFAULT_ENCODER, choices=ENCODERS, help="LLM-1 encoder"
     )
     args = parser.parse_args()
     console = Console()
-    config = LanguageConfig(embedded=EmbeddedConfig(intent_model=args.intent_model))
+    config = LanguageConfig(embedded=EmbeddedConfig(encoder=args.encoder))
     stack = make_language_stack(args.backend, config)
     t0 = time.perf_counter()
-    stack.load()  # every encoder the interpreter may use
-    stack.interpreter.interpret("warm up")
+    stack.interpreter.interpret("warm up")  # loads the encoder
     load_s = time.perf_counter() - t0
 
-    # the held-out test requests: the shipped models never saw them, so the cascade
-    # escalates as often as it would on new passengers' requests
-    texts = [r.text for r in load_commands(data_path(TEST_CSV))]
+    texts = [r.text for r in load_commands(data_path(TEST_CSV))]  # requests it never saw
     records = [r.record() for r in load_decisions(data_path(DECISIONS_JSONL))]
-    lat_i, models = [], []
+    lat_i = []
     for k in range(args.n):
         t = time.perf_counter()
-        result = stack.interpreter.interpret(texts[k % len(texts)])
+        stack.interpreter.interpret(texts[k % len(texts)])
         lat_i.append(time.perf_counter() - t)
-        models.append(result.model)
     lat_d, lat_de = [], []
     for k in range(args.n):
         rec = records[k % len(records)]
@@ -84,7 +80,7 @@ def main() -> None:
         lat_de.append(time.perf_counter() - t)
 
     table = Table(
-        title=f"language layer, backend {args.backend}, intent model {args.intent_model} "
+        title=f"language layer, backend {args.backend}, encoder {args.encoder} "
         f"(load {load_s:.1f} s)"
     )
     for col in ("call", "n", "p50 [ms]", "p95 [ms]"):
@@ -93,9 +89,6 @@ def main() -> None:
         p50, p95 = pct(lat)
         table.add_row(name, str(len(lat)), f"{p50:.3f}", f"{p95:.3f}")
     console.print(table)
-    if any(models):
-        shares = ", ".join(f"{m} {models.count(m) / len(models):.3f}" for m in sorted(set(models)))
-        console.print(f"interpret answered by (share of {len(models)} requests): {shares}")
 
     espeak = shutil.which("espeak-ng")
     if espeak is None:

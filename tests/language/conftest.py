@@ -16,13 +16,22 @@ from typing import Any
 import pytest
 
 from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
+from explaindrive.language.config import EmbeddedConfig
 from explaindrive.language.speech import Transcriber
 
 
 @pytest.fixture(scope="session")
 def interpreter() -> EmbeddedIntentInterpreter:
-    """The embedded LLM-1 with its encoder loaded once for the whole session."""
+    """The default embedded LLM-1 (mpnet), its encoder loaded once for the whole session."""
     it = EmbeddedIntentInterpreter()
+    it.load()
+    return it
+
+
+@pytest.fixture(scope="session")
+def minilm() -> EmbeddedIntentInterpreter:
+    """The embedded LLM-1 over all-MiniLM-L6-v2, loaded once for the whole session."""
+    it = EmbeddedIntentInterpreter(EmbeddedConfig(encoder="minilm"))
     it.load()
     return it
 

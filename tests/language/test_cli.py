@@ -54,8 +54,8 @@ def test_interpret_json_and_bad_backend(interpreter) -> None:  # type: ignore[no
     }
     res = runner.invoke(app, ["interpret", "hi", "--backend", "gpt9"])
     assert res.exit_code == 2 and "unknown language backend" in res.output
-    res = runner.invoke(app, ["interpret", "hi", "--intent-model", "bert"])
-    assert res.exit_code == 2 and "unknown intent model 'bert'" in res.output
+    res = runner.invoke(app, ["interpret", "hi", "--encoder", "bert"])
+    assert res.exit_code == 2 and "unknown sentence encoder 'bert'" in res.output
 
 
 def test_transcribe_and_interpret_audio(transcriber, speak, tmp_path) -> None:  # type: ignore[no-untyped-def]

@@ -8,8 +8,8 @@ from explaindrive.language.cues import N_CUES
 from explaindrive.language.features import HASH_FEATURES, FeatureSpec, features
 
 
-def test_encoder_matches_sentence_transformers(interpreter) -> None:  # type: ignore[no-untyped-def]
-    enc = interpreter.encoder
+def test_encoder_matches_sentence_transformers(minilm) -> None:  # type: ignore[no-untyped-def]
+    enc = minilm.encoder
     texts = ["could you go a bit faster", "stop", "please take it easy, I'm carrying soup"] * 30
     ours = enc.encode(texts)  # 90 texts: two forward batches, padded differently
     ref = enc._model.encode(texts, normalize_embeddings=True, show_progress_bar=False)
@@ -19,9 +19,9 @@ def test_encoder_matches_sentence_transformers(interpreter) -> None:  # type: ig
     assert enc.encode([]).shape == (0, 384)
 
 
-def test_feature_layout(interpreter) -> None:  # type: ignore[no-untyped-def]
+def test_feature_layout(minilm) -> None:  # type: ignore[no-untyped-def]
     spec = FeatureSpec(ngram_weight=2.0, cue_weight=0.5)
-    x = features(interpreter.encoder, ["go faster", "slow down"], spec)
+    x = features(minilm.encoder, ["go faster", "slow down"], spec)
     assert x.shape == (2, 384 + HASH_FEATURES + N_CUES)
     # the n-gram block is l2-normalised, then scaled by its weight
     np.testing.assert_allclose(np.linalg.norm(x[:, 384 : 384 + HASH_FEATURES], axis=1), 2.0)

@@ -102,17 +102,18 @@ def test_openai_backend_that_times_out_falls_back(tmp_path: Path) -> None:
     assert len(session.records) == 12
 
 
-def test_ride_with_mpnet_alone_reads_the_default_script(tmp_path: Path) -> None:
+def test_ride_with_the_minilm_encoder_reads_the_default_script(tmp_path: Path) -> None:
     from typer.testing import CliRunner
 
     from explaindrive.cli.main import app
 
     runner = CliRunner()
-    res = runner.invoke(app, ["ride", "--intent-model", "x", "--no-live", "--out", str(tmp_path)])
-    assert res.exit_code == 2 and "unknown intent model 'x'" in res.output
-    out = tmp_path / "mpnet"
-    args = ["ride", "--intent-model", "mpnet", "--no-live", "--max-steps", "120"]
-    res = runner.invoke(app, [*args, "--out", str(out)])
+    res = runner.invoke(app, ["ride", "--encoder", "bert", "--no-live", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "unknown sentence encoder 'bert'" in res.output
+    out = tmp_path / "minilm"
+    res = runner.invoke(
+        app, ["ride", "--encoder", "minilm", "--no-live", "--max-steps", "120", "--out", str(out)]
+    )
     assert res.exit_code == 0, res.output
     steps = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
     read = [e for s in steps for e in s.get("passenger", []) if e["type"] == "interpretation"]

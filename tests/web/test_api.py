@@ -253,6 +253,6 @@ def test_a_ride_that_cannot_start():
 def test_real_stack_checks_backend_and_encoder() -> None:
     with pytest.raises(ValueError, match="backend must be"):
         RealStack("gpt9")
-    with pytest.raises(ValueError, match="unknown intent model 'bert'"):
+    with pytest.raises(ValueError, match="unknown sentence encoder 'bert'"):
         RealStack("embedded", "bert")
-    assert RealStack("embedded", "mpnet").intent_model == "mpnet"  # loads on the first ride
+    assert RealStack("embedded", "minilm").encoder == "minilm"  # models load on the first ride

@@ -10,25 +10,25 @@ import typer
 from rich.console import Console
 
 from explaindrive.language.config import LanguageConfig
-from explaindrive.language.encoders import check_intent_model
+from explaindrive.language.encoders import check_encoder
 
 console = Console()
 err_console = Console(stderr=True)
 
 BACKEND_HELP = "Language backend: embedded (offline, default) or openai."
 CONFIG_HELP = "YAML language config (see docs/language.md)."
-INTENT_MODEL_HELP = "LLM-1 model of the embedded backend: cascade (default), minilm or mpnet."
+ENCODER_HELP = "LLM-1 sentence encoder of the embedded backend: mpnet (default) or minilm."
 
 
-def load_config(path: Path | None, intent_model: str | None = None) -> LanguageConfig:
-    """The language config from ``path`` or the defaults, with ``intent_model`` (if given)
-    replacing ``embedded.intent_model``; exits with a message on errors."""
+def load_config(path: Path | None, encoder: str | None = None) -> LanguageConfig:
+    """The language config from ``path`` or the defaults, with ``encoder`` (if given)
+    replacing ``embedded.encoder``; exits with a message on errors."""
     try:
         config = LanguageConfig() if path is None else LanguageConfig.from_yaml(path)
-        if intent_model is None:
+        if encoder is None:
             return config
         raw = config.model_dump()
-        raw["embedded"]["intent_model"] = check_intent_model(intent_model)
+        raw["embedded"]["encoder"] = check_encoder(encoder)
         return LanguageConfig.model_validate(raw)
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))

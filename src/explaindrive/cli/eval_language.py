@@ -12,7 +12,7 @@ from rich.table import Table
 from explaindrive.cli._language_common import (
     BACKEND_HELP,
     CONFIG_HELP,
-    INTENT_MODEL_HELP,
+    ENCODER_HELP,
     console,
     fail,
     load_config,
@@ -42,24 +42,22 @@ def intents_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
-    intent_model: Annotated[
-        str | None, typer.Option("--intent-model", help=INTENT_MODEL_HELP)
-    ] = None,
+    encoder: Annotated[str | None, typer.Option("--encoder", help=ENCODER_HELP)] = None,
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
     try:
         rows = load_commands(data)
         from explaindrive.language.stack import make_language_stack
 
-        cfg = load_config(config, intent_model)
+        cfg = load_config(config, encoder)
         stack = make_language_stack(backend, cfg)
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_intents
 
     report = evaluate_intents(stack.interpreter, rows)
-    report.update(backend=stack.backend, intent_model=cfg.embedded.intent_model, data=str(data))
-    table = Table(title=f"LLM-1 on {data.name} ({stack.backend}, {cfg.embedded.intent_model})")
+    report.update(backend=stack.backend, encoder=cfg.embedded.encoder, data=str(data))
+    table = Table(title=f"LLM-1 on {data.name} ({stack.backend}, {cfg.embedded.encoder})")
     for col in ("class", "precision", "recall", "F1", "support"):
         table.add_column(col, justify="right")
     for name, m in report["per_class"].items():

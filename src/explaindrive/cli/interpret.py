@@ -10,7 +10,7 @@ import typer
 from explaindrive.cli._language_common import (
     BACKEND_HELP,
     CONFIG_HELP,
-    INTENT_MODEL_HELP,
+    ENCODER_HELP,
     console,
     emit_json,
     fail,
@@ -25,9 +25,7 @@ def interpret_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
-    intent_model: Annotated[
-        str | None, typer.Option("--intent-model", help=INTENT_MODEL_HELP)
-    ] = None,
+    encoder: Annotated[str | None, typer.Option("--encoder", help=ENCODER_HELP)] = None,
 ) -> None:
     """Map a passenger request (text or --audio) to fast, comfort, stop or no command."""
     if (text is None) == (audio is None):
@@ -35,7 +33,7 @@ def interpret_command(
     try:
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config, intent_model))
+        stack = make_language_stack(backend, load_config(config, encoder))
     except ValueError as exc:
         fail(str(exc))
     transcript = None

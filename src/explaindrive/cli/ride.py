@@ -12,7 +12,8 @@ import typer
 from rich.console import Console
 from rich.live import Live
 
-from explaindrive.cli._language_common import INTENT_MODEL_HELP
+from explaindrive.cli._language_common import ENCODER_HELP
+from explaindrive.language.encoders import DEFAULT_ENCODER
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.script import AUDIO_PREFIX, ScriptError, default_script_path, load_script
 
@@ -32,7 +33,7 @@ def ride(
     backend: str = typer.Option(
         "embedded", "--backend", help="Language backend: embedded or openai."
     ),
-    intent_model: str = typer.Option("cascade", "--intent-model", help=INTENT_MODEL_HELP),
+    encoder: str = typer.Option(DEFAULT_ENCODER, "--encoder", help=ENCODER_HELP),
     traffic: float = typer.Option(1.0, "--traffic", help="Traffic level (1.0 = 900 veh/h)."),
     seed: int = typer.Option(0, "--seed", help="Simulation seed."),
     gui: bool = typer.Option(False, "--gui", help="Show the ride in sumo-gui."),
@@ -52,7 +53,7 @@ def ride(
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.controller import MergedController
     from explaindrive.language.config import EmbeddedConfig, LanguageConfig
-    from explaindrive.language.encoders import check_intent_model
+    from explaindrive.language.encoders import check_encoder
     from explaindrive.language.stack import make_language_stack
     from explaindrive.ride.runner import run_ride
     from explaindrive.ride.session import RideSession
@@ -76,9 +77,7 @@ def ride(
             else load_script(script or default_script_path(), max_time_s=float(max_steps))
         )
         controller = MergedController.from_package()
-        language_config = LanguageConfig(
-            embedded=EmbeddedConfig(intent_model=check_intent_model(intent_model))
-        )
+        language_config = LanguageConfig(embedded=EmbeddedConfig(encoder=check_encoder(encoder)))
     except (ValueError, ScriptError, CheckpointError) as exc:
         console.print(f"[red]error:[/red] {exc}")
         raise typer.Exit(2) from exc

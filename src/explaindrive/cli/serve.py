@@ -5,8 +5,8 @@ from __future__ import annotations
 import typer
 from rich.console import Console
 
-from explaindrive.cli._language_common import INTENT_MODEL_HELP
-from explaindrive.language.encoders import INTENT_MODELS
+from explaindrive.cli._language_common import ENCODER_HELP
+from explaindrive.language.encoders import DEFAULT_ENCODER, ENCODERS
 
 console = Console()
 
@@ -19,7 +19,7 @@ def serve(
     backend: str = typer.Option(
         "embedded", "--backend", help="Language backend: embedded or openai."
     ),
-    intent_model: str = typer.Option("cascade", "--intent-model", help=INTENT_MODEL_HELP),
+    encoder: str = typer.Option(DEFAULT_ENCODER, "--encoder", help=ENCODER_HELP),
     step_period: float = typer.Option(
         1.0,
         "--step-period",
@@ -36,15 +36,14 @@ def serve(
     if backend not in ("embedded", "openai"):
         console.print(f"[red]error:[/red] unknown backend {backend!r}; use embedded or openai")
         raise typer.Exit(2)
-    if intent_model not in INTENT_MODELS:
-        choices = ", ".join(INTENT_MODELS)
-        console.print(f"[red]error:[/red] unknown intent model {intent_model!r}; use {choices}")
+    if encoder not in ENCODERS:
+        console.print(f"[red]error:[/red] unknown encoder {encoder!r}; use {' or '.join(ENCODERS)}")
         raise typer.Exit(2)
     if host not in ("127.0.0.1", "localhost", "::1"):
         console.print(
             f"[yellow]warning:[/yellow] binding {host} exposes the ride controls to the network"
         )
-    app = create_app(backend=backend, intent_model=intent_model, step_period_s=step_period)
+    app = create_app(backend=backend, encoder=encoder, step_period_s=step_period)
     console.print(f"passenger page: http://{host}:{port}/  (Ctrl+C to stop)")
     uvicorn.run(app, host=host, port=port, log_level="warning")
 

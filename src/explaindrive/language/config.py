@@ -6,9 +6,9 @@ from pathlib import Path
 from typing import Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field
 
-from explaindrive.language.encoders import IntentModelName
+from explaindrive.language.encoders import DEFAULT_ENCODER, EncoderName
 
 BackendName = Literal["embedded", "openai"]
 
@@ -39,18 +39,14 @@ class SpeechConfig(_Strict):
 class EmbeddedConfig(_Strict):
     """Offline backend: sentence embeddings + shipped classifier, rule engine, templates."""
 
-    intent_model: IntentModelName = "cascade"
-    """LLM-1 model: ``cascade`` (default: all-MiniLM-L6-v2, and all-mpnet-base-v2 for the
-    requests MiniLM is least sure of), ``minilm`` or ``mpnet`` alone."""
-    escalation_margin: float | None = Field(default=None, ge=0.0, le=1.0)
-    """Cascade: a request goes to mpnet when MiniLM's two most probable labels are at most
-    this far apart; ``None`` = the shipped, held-out-tuned value."""
+    encoder: EncoderName = DEFAULT_ENCODER
+    """Sentence encoder of LLM-1: ``mpnet`` (all-mpnet-base-v2, default) or ``minilm``
+    (all-MiniLM-L6-v2: about four times faster, more errors; see docs/language.md)."""
     embedding_model_dir: Path | None = None
-    """sentence-transformers model directory for ``minilm`` or ``mpnet`` alone; ``None`` =
-    the encoder's packaged model."""
+    """sentence-transformers model directory; ``None`` = the encoder's packaged model."""
     classifier_path: Path | None = None
-    """``.npz`` classifier weights for ``minilm`` or ``mpnet`` alone; ``None`` = the weights
-    shipped in ``language/data``."""
+    """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data`` for
+    ``encoder``."""
     stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
     """STOP wins whenever its probability reaches this; ``None`` = the value stored with the
     weights (tuned on the held-out development splits)."""
@@ -61,17 +57,6 @@ class EmbeddedConfig(_Strict):
     """torch threads while encoding a request (1 is fastest on a CPU shared with SUMO)."""
     cutoff_m: float = Field(default=SUMMARY_CUTOFF_M, gt=0.0)
     """[m] objects farther than this are ignored by the decider and the explainer."""
-
-    @model_validator(mode="after")
-    def _paths_need_one_encoder(self) -> EmbeddedConfig:
-        if self.intent_model == "cascade" and (
-            self.embedding_model_dir is not None or self.classifier_path is not None
-        ):
-            raise ValueError(
-                "embedding_model_dir and classifier_path need intent_model minilm or mpnet "
-                "(the cascade uses both packaged models)"
-            )
-        return self
 
 
 class OpenAIConfig(_Strict):

@@ -77,8 +77,6 @@ CLASSIFIER_FILES: dict[str, str] = {
     "mpnet": "intent_classifier_mpnet.npz",
 }
 """The shipped LLM-1 weights per sentence encoder."""
-CASCADE_JSON = "intent_cascade.json"
-"""When the LLM-1 cascade hands a request from the MiniLM to the mpnet model."""
 
 
 @dataclass(frozen=True, slots=True)

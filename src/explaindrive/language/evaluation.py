@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections import Counter
 from typing import Any
 
 import numpy as np
@@ -89,27 +88,17 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
     latencies: list[float] = []
     fallbacks = 0
     errors = []
-    answered_by: Counter[str] = Counter()
     for row in rows:
         r = interpreter.interpret(row.text)
-        answered_by[r.model or r.backend] += 1
         label = r.intent.label if r.intent is not None else "none"
         preds.append(label)
         confs.append(r.confirmation)
         latencies.append(r.latency_s)
         fallbacks += r.fallback
         if label != row.label:
-            errors.append(
-                {"text": row.text, "label": row.label, "pred": label, "kind": row.kind}
-                | ({"model": r.model} if r.model else {})
-            )
+            errors.append({"text": row.text, "label": row.label, "pred": label, "kind": row.kind})
     out = intent_metrics([r.label for r in rows], preds, confs)
-    out.update(
-        errors=errors,
-        fallbacks=fallbacks,
-        latency=_percentiles(latencies),
-        answered_by=dict(sorted(answered_by.items())),
-    )
+    out.update(errors=errors, fallbacks=fallbacks, latency=_percentiles(latencies))
     return out
 
 

@@ -22,7 +22,12 @@ from numpy.typing import NDArray
 from sklearn.feature_extraction.text import HashingVectorizer
 
 from explaindrive.language.cues import N_CUES, cue_features
-from explaindrive.language.encoders import EncoderName, check_encoder, encoder_model_dir
+from explaindrive.language.encoders import (
+    DEFAULT_ENCODER,
+    EncoderName,
+    check_encoder,
+    encoder_model_dir,
+)
 
 log = logging.getLogger(__name__)
 
@@ -36,7 +41,7 @@ class SentenceEncoder:
     """Lazily loaded, offline sentence-transformers encoder (unit-norm embeddings)."""
 
     def __init__(
-        self, model_dir: Path | None = None, threads: int = 1, name: EncoderName = "minilm"
+        self, model_dir: Path | None = None, threads: int = 1, name: EncoderName = DEFAULT_ENCODER
     ) -> None:
         """Build an encoder (the model loads on first use).
 
@@ -135,7 +140,7 @@ class FeatureSpec:
     ngram_weight: float = NGRAM_WEIGHT
     cue_weight: float = CUE_WEIGHT
     n_cues: int = N_CUES
-    encoder: str = "minilm"
+    encoder: str = DEFAULT_ENCODER
     """The sentence encoder whose embeddings lead the feature row."""
 
 

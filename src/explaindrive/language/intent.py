@@ -41,7 +41,6 @@ class IntentResult:
         latency_s: wall time of the call [s].
         scores: class probabilities when the backend exposes them (embedded), else empty.
         error: why the configured backend was bypassed, when ``fallback`` is ``True``.
-        model: which embedded model answered (``minilm`` / ``mpnet``), else empty.
     """
 
     intent: Command | None
@@ -51,7 +50,6 @@ class IntentResult:
     latency_s: float
     scores: dict[str, float]
     error: str | None = None
-    model: str = ""
 
     def to_json(self) -> dict[str, object]:
         """The CLI's JSON shape."""

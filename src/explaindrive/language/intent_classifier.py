@@ -15,8 +15,8 @@ off-topic only when its off-topic probability leads the best command's by more t
 ``COMMAND_DROP_COST`` off-topic requests answered with a confirmation question. Retrain
 and re-ship the weights with::
 
-    python -m explaindrive.language.intent_classifier                   # MiniLM (default)
-    python -m explaindrive.language.intent_classifier --encoder mpnet   # the mpnet extra
+    python -m explaindrive.language.intent_classifier                    # mpnet (default)
+    python -m explaindrive.language.intent_classifier --encoder minilm
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ from explaindrive.language.datasets import (
     data_path,
     load_commands,
 )
-from explaindrive.language.encoders import ENCODERS, check_encoder
+from explaindrive.language.encoders import DEFAULT_ENCODER, ENCODERS, check_encoder
 from explaindrive.language.features import (
     FeatureSpec,
     SentenceEncoder,
@@ -152,7 +152,9 @@ class IntentClassifier:
         )
 
     @classmethod
-    def load(cls, path: str | Path | None = None, encoder: str = "minilm") -> IntentClassifier:
+    def load(
+        cls, path: str | Path | None = None, encoder: str = DEFAULT_ENCODER
+    ) -> IntentClassifier:
         """Read weights (default: the ones shipped for ``encoder``).
 
         Raises:
@@ -178,6 +180,7 @@ class IntentClassifier:
                         float(z["ngram_weight"]),
                         float(z["cue_weight"]),
                         int(z["n_cues"]),
+                        # files without the key predate the choice: MiniLM was the only one
                         str(z["encoder"]) if "encoder" in z.files else "minilm",
                     ),
                     lr_weight=float(z["lr_weight"]),
@@ -320,9 +323,6 @@ class Selection:
     none_margin: float  # cost-tuned on the pooled held-out probabilities
     stop_recall: float
     false_stops: int
-    cost: float  # :func:`selection_cost` of the pooled held-out predictions
-    proba: NDArray[np.float64] = field(repr=False)
-    """Pooled held-out probabilities of the development requests (rows in split order)."""
 
 
 def held_out_proba(
@@ -403,17 +403,13 @@ def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...
                 cost,
             )
             if best is None or (cost, false_stops) < (best[0], best[1]):
-                best = (
-                    cost,
-                    false_stops,
-                    Selection(hyper, acc, t, m, recall, false_stops, cost, p),
-                )
+                best = (cost, false_stops, Selection(hyper, acc, t, m, recall, false_stops))
     assert best is not None
     return best[2]
 
 
 def fit_final(
-    train: Encoded, devs: list[Encoded], sel: Selection, encoder: str = "minilm"
+    train: Encoded, devs: list[Encoded], sel: Selection, encoder: str = DEFAULT_ENCODER
 ) -> IntentClassifier:
     """Fit the shipped model on the training and all development requests (embedded by
     ``encoder``)."""
@@ -466,7 +462,7 @@ def main(argv: list[str] | None = None) -> None:
         help="development splits (at least two; each is held out in turn)",
     )
     parser.add_argument(
-        "--encoder", choices=ENCODERS, default="minilm", help="sentence encoder (default minilm)"
+        "--encoder", choices=ENCODERS, default=DEFAULT_ENCODER, help="sentence encoder"
     )
     parser.add_argument(
         "--out", type=Path, default=None, help="weights file (default: the shipped one)"

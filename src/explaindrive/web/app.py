@@ -27,7 +27,7 @@ from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from starlette.datastructures import UploadFile
 
-from explaindrive.language.encoders import check_intent_model
+from explaindrive.language.encoders import DEFAULT_ENCODER, check_encoder
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.sim.scenario.files import default_scenario
@@ -56,14 +56,14 @@ class RealStack:
 
     Args:
         backend: language backend, ``embedded`` or ``openai``.
-        intent_model: LLM-1 model of the embedded backend (``cascade``, ``minilm``, ``mpnet``).
+        encoder: LLM-1 sentence encoder of the embedded backend (``minilm`` or ``mpnet``).
     """
 
-    def __init__(self, backend: str = "embedded", intent_model: str = "cascade") -> None:
+    def __init__(self, backend: str = "embedded", encoder: str = DEFAULT_ENCODER) -> None:
         if backend not in ("embedded", "openai"):
             raise ValueError(f"backend must be 'embedded' or 'openai', got {backend!r}")
         self.backend = backend
-        self.intent_model = check_intent_model(intent_model)
+        self.encoder = check_encoder(encoder)
         self._controller: Any = None
         self._language: Any = None
 
@@ -78,9 +78,7 @@ class RealStack:
         if self._controller is None:
             self._controller = MergedController.from_package()
         if self._language is None:
-            language_config = LanguageConfig(
-                embedded=EmbeddedConfig(intent_model=self.intent_model)
-            )
+            language_config = LanguageConfig(embedded=EmbeddedConfig(encoder=self.encoder))
             self._language = make_language_stack(self.backend, language_config).load()
         return RideSession(replace(config, backend=self.backend), self._controller, self._language)
 
@@ -89,7 +87,7 @@ def create_app(
     session_factory: SessionFactory | None = None,
     *,
     backend: str = "embedded",
-    intent_model: str = "cascade",
+    encoder: str = DEFAULT_ENCODER,
     step_period_s: float = 1.0,
     max_upload_bytes: int = MAX_UPLOAD_BYTES,
 ) -> FastAPI:
@@ -99,11 +97,11 @@ def create_app(
         session_factory: builds a ride session from its settings; the real stack
             (:class:`RealStack` with ``backend``) when omitted. Tests inject fakes here.
         backend: language backend of the default factory.
-        intent_model: LLM-1 model of the default factory's embedded backend.
+        encoder: LLM-1 sentence encoder of the default factory's embedded backend.
         step_period_s: wall time per 1 s control step [s]; 1.0 rides in real time.
         max_upload_bytes: largest accepted audio upload [B].
     """
-    factory = session_factory or RealStack(backend, intent_model)
+    factory = session_factory or RealStack(backend, encoder)
     scene = load_scene(default_scenario().net_file)
     manager = RideManager(factory, scene, step_period_s=step_period_s)
 

@@ -4,17 +4,11 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import replace
-
-import numpy as np
-from numpy.typing import NDArray
 
 from explaindrive.commands import Command
-from explaindrive.language.cascade import LARGE, SMALL, CascadeRule
 from explaindrive.language.config import EmbeddedConfig
 from explaindrive.language.datasets import INTENT_LABELS
 from explaindrive.language.decision import Decision, ExplanationDecider, Factor, rule_decision
-from explaindrive.language.encoders import EncoderName
 from explaindrive.language.explanation import Explainer, Explanation, template_explanation
 from explaindrive.language.features import SentenceEncoder, features
 from explaindrive.language.intent import (
@@ -31,73 +25,39 @@ log = logging.getLogger(__name__)
 NAME = "embedded"
 
 
-class IntentStage:
-    """One sentence encoder with the classifier shipped for it."""
-
-    def __init__(self, name: EncoderName, config: EmbeddedConfig) -> None:
-        """Args: name: the encoder; config: backend options (threads, paths)."""
-        self.encoder = SentenceEncoder(config.embedding_model_dir, config.encoder_threads, name)
-        self.classifier = IntentClassifier.load(config.classifier_path, name)
-
-    def proba(self, text: str) -> NDArray[np.float64]:
-        """Class probabilities of one request."""
-        return self.classifier.proba(features(self.encoder, [text], self.classifier.spec))[0]
-
-
 class EmbeddedIntentInterpreter(IntentInterpreter):
-    """LLM-1 offline: sentence-encoder features and a shipped classifier, one encoder or
-    the cascade of :mod:`explaindrive.language.cascade` (MiniLM, then mpnet for the
-    requests MiniLM is least sure of)."""
+    """LLM-1 offline: sentence-encoder features + the classifier shipped for that encoder."""
 
     name = NAME
 
-    def __init__(self, config: EmbeddedConfig | None = None) -> None:
-        """Args: config: backend options (``intent_model`` picks the model)."""
+    def __init__(
+        self, config: EmbeddedConfig | None = None, encoder: SentenceEncoder | None = None
+    ) -> None:
+        """Args: config: backend options; encoder: share one loaded encoder between users."""
         self.config = config or EmbeddedConfig()
-        model = self.config.intent_model
-        names: tuple[EncoderName, ...] = (SMALL, LARGE) if model == "cascade" else (model,)
-        self.stages = [IntentStage(n, self.config) for n in names]
-        self.rule: CascadeRule | None = None
-        if model == "cascade":
-            rule = CascadeRule.load()
-            if self.config.escalation_margin is not None:
-                rule = replace(rule, escalation_margin=self.config.escalation_margin)
-            self.rule = rule
-
-    @property
-    def encoder(self) -> SentenceEncoder:
-        """The first (for the cascade: the small) encoder."""
-        return self.stages[0].encoder
-
-    @property
-    def classifier(self) -> IntentClassifier:
-        """The first (for the cascade: the small) encoder's classifier."""
-        return self.stages[0].classifier
+        self.encoder = encoder or SentenceEncoder(
+            self.config.embedding_model_dir, self.config.encoder_threads, self.config.encoder
+        )
+        self.classifier = IntentClassifier.load(self.config.classifier_path, self.encoder.name)
 
     def load(self) -> None:
-        """Load the sentence encoders now rather than on the first request."""
-        for stage in self.stages:
-            stage.encoder.load()
+        """Load the sentence encoder now rather than on the first request."""
+        self.encoder.load()
 
     def interpret(self, text: str) -> IntentResult:
         """Classify ``text``; an empty or off-topic request gets a request to rephrase."""
         t0 = time.perf_counter()
         if not text or not text.strip():
             return IntentResult(None, REPHRASE_MESSAGE, NAME, False, time.perf_counter() - t0, {})
-        stage = self.stages[0]
-        p = stage.proba(text)
-        if self.rule is not None and self.rule.escalate(p):
-            stage = self.stages[1]
-            p = stage.proba(text)
-        label = stage.classifier.decide(p, self.config.stop_threshold, self.config.none_margin)
+        x = features(self.encoder, [text], self.classifier.spec)
+        p = self.classifier.proba(x)[0]
+        label = self.classifier.decide(p, self.config.stop_threshold, self.config.none_margin)
         scores = {name: round(float(v), 4) for name, v in zip(INTENT_LABELS, p, strict=True)}
         intent = None if label == "none" else Command.parse(label)
         confirmation = format_confirmation(intent) if intent is not None else REPHRASE_MESSAGE
         latency = time.perf_counter() - t0
-        log.debug("embedded intent %s for %r by %s (%s)", label, text, stage.encoder.name, scores)
-        return IntentResult(
-            intent, confirmation, NAME, False, latency, scores, model=stage.encoder.name
-        )
+        log.debug("embedded intent %s for %r (%s)", label, text, scores)
+        return IntentResult(intent, confirmation, NAME, False, latency, scores)
 
 
 class RuleDecider(ExplanationDecider):
