@@ -66,12 +66,12 @@ TEST6_CSV = "commands_test6.csv"
 """Held-out requests of round 11, written before the shipped MiniLM and mpnet models and
 evaluated once by each; never used to build them."""
 TEST_CSV = "commands_test7.csv"
-"""Held-out requests of round 12, written before the shipped cascade rule and never used to
-build any shipped model."""
+"""Held-out requests of round 12, written after the shipped models were built and evaluated
+once by each; never used to build them."""
 TEST_SPLITS: tuple[str, ...] = (TEST6_CSV, TEST_CSV)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
-"""The shipped LLM-1 weights over the default encoder (MiniLM)."""
+"""The shipped LLM-1 weights over all-MiniLM-L6-v2."""
 CLASSIFIER_FILES: dict[str, str] = {
     "minilm": CLASSIFIER_NPZ,
     "mpnet": "intent_classifier_mpnet.npz",
