@@ -23,7 +23,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from explaindrive.language.config import EmbeddedConfig, LanguageConfig
+from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
     TEST_CSV,
@@ -56,7 +56,7 @@ def main() -> None:
     )
     args = parser.parse_args()
     console = Console()
-    config = LanguageConfig(embedded=EmbeddedConfig(encoder=args.encoder))
+    config = LanguageConfig().with_encoder(args.encoder)
     stack = make_language_stack(args.backend, config)
     t0 = time.perf_counter()
     stack.interpreter.interpret("warm up")  # loads the encoder

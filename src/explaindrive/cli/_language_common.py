@@ -10,7 +10,6 @@ import typer
 from rich.console import Console
 
 from explaindrive.language.config import LanguageConfig
-from explaindrive.language.encoders import check_encoder
 
 console = Console()
 err_console = Console(stderr=True)
@@ -25,11 +24,7 @@ def load_config(path: Path | None, encoder: str | None = None) -> LanguageConfig
     replacing ``embedded.encoder``; exits with a message on errors."""
     try:
         config = LanguageConfig() if path is None else LanguageConfig.from_yaml(path)
-        if encoder is None:
-            return config
-        raw = config.model_dump()
-        raw["embedded"]["encoder"] = check_encoder(encoder)
-        return LanguageConfig.model_validate(raw)
+        return config if encoder is None else config.with_encoder(encoder)
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
 

@@ -52,8 +52,7 @@ def ride(
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.controller import MergedController
-    from explaindrive.language.config import EmbeddedConfig, LanguageConfig
-    from explaindrive.language.encoders import check_encoder
+    from explaindrive.language.config import LanguageConfig
     from explaindrive.language.stack import make_language_stack
     from explaindrive.ride.runner import run_ride
     from explaindrive.ride.session import RideSession
@@ -77,7 +76,7 @@ def ride(
             else load_script(script or default_script_path(), max_time_s=float(max_steps))
         )
         controller = MergedController.from_package()
-        language_config = LanguageConfig(embedded=EmbeddedConfig(encoder=check_encoder(encoder)))
+        language_config = LanguageConfig().with_encoder(encoder)
     except (ValueError, ScriptError, CheckpointError) as exc:
         console.print(f"[red]error:[/red] {exc}")
         raise typer.Exit(2) from exc

@@ -6,7 +6,7 @@ import typer
 from rich.console import Console
 
 from explaindrive.cli._language_common import ENCODER_HELP
-from explaindrive.language.encoders import DEFAULT_ENCODER, ENCODERS
+from explaindrive.language.encoders import DEFAULT_ENCODER, check_encoder
 
 console = Console()
 
@@ -36,9 +36,11 @@ def serve(
     if backend not in ("embedded", "openai"):
         console.print(f"[red]error:[/red] unknown backend {backend!r}; use embedded or openai")
         raise typer.Exit(2)
-    if encoder not in ENCODERS:
-        console.print(f"[red]error:[/red] unknown encoder {encoder!r}; use {' or '.join(ENCODERS)}")
-        raise typer.Exit(2)
+    try:
+        check_encoder(encoder)  # before the server starts
+    except ValueError as exc:
+        console.print(f"[red]error:[/red] {exc}")
+        raise typer.Exit(2) from exc
     if host not in ("127.0.0.1", "localhost", "::1"):
         console.print(
             f"[yellow]warning:[/yellow] binding {host} exposes the ride controls to the network"

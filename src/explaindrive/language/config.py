@@ -8,7 +8,7 @@ from typing import Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
-from explaindrive.language.encoders import DEFAULT_ENCODER, EncoderName
+from explaindrive.language.encoders import DEFAULT_ENCODER, EncoderName, check_encoder
 
 BackendName = Literal["embedded", "openai"]
 
@@ -83,6 +83,15 @@ class LanguageConfig(_Strict):
     speech: SpeechConfig = SpeechConfig()
     embedded: EmbeddedConfig = EmbeddedConfig()
     openai: OpenAIConfig = OpenAIConfig()
+
+    def with_encoder(self, encoder: str) -> LanguageConfig:
+        """This config with ``embedded.encoder`` replaced.
+
+        Raises:
+            ValueError: for an unknown encoder name.
+        """
+        embedded = self.embedded.model_copy(update={"encoder": check_encoder(encoder)})
+        return self.model_copy(update={"embedded": embedded})
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> LanguageConfig:

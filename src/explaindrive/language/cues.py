@@ -59,6 +59,8 @@ TOO_FAST_WORDS = _words(
 )
 # Requests to stop the trip, and words of continuing (negated: "no further").
 STOP_VERBS = _words("stop halt park stopping cease")
+# Verbs that forbid the action of a following gerund ("stop speeding", "quit tailgating").
+_QUIT_VERBS = _words("stop quit cease")
 # "stop moving" halts the car, unless a manner follows ("stop driving like a maniac").
 _MOTION_GERUNDS = _words("moving driving going rolling travelling traveling")
 _HALT_FOLLOWERS = _words("now immediately instantly here please right asap")
@@ -327,12 +329,12 @@ def cue_vector(text: str) -> NDArray[np.float32]:
         if t in NEGATORS or (t == "need" and prev == "no"):
             _in_scope(tokens, negated, i)
         elif (
-            t in ("stop", "quit", "cease")
+            t in _QUIT_VERBS
             and nxt in _MOTION_GERUNDS
             and (i + 2 >= n or tokens[i + 2] in _CLAUSE_BREAKS or tokens[i + 2] in _HALT_FOLLOWERS)
         ):
             stop_role[i] = "request"  # "stop moving now", "cease driving."
-        elif t in ("stop", "quit", "cease") and (_is_gerund(nxt) or nxt == "being"):
+        elif t in _QUIT_VERBS and (_is_gerund(nxt) or nxt == "being"):
             stop_role[i] = "negator"  # "stop speeding" = do not speed
             _in_scope(tokens, negated, i)
         elif t == "stop" and prev in _POSSESSIVES:

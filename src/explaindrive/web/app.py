@@ -72,13 +72,13 @@ class RealStack:
         from dataclasses import replace
 
         from explaindrive.agent.controller import MergedController
-        from explaindrive.language.config import EmbeddedConfig, LanguageConfig
+        from explaindrive.language.config import LanguageConfig
         from explaindrive.language.stack import make_language_stack
 
         if self._controller is None:
             self._controller = MergedController.from_package()
         if self._language is None:
-            language_config = LanguageConfig(embedded=EmbeddedConfig(encoder=self.encoder))
+            language_config = LanguageConfig().with_encoder(self.encoder)
             self._language = make_language_stack(self.backend, language_config).load()
         return RideSession(replace(config, backend=self.backend), self._controller, self._language)
 
