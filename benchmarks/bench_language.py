@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_language.py [--backend embedded|openai] [--n 200]
-        [--encoder mpnet|minilm]
+        [--encoder mpnet|minilm] [--runtime onnx|torch]
 
 Prints p50/p95 latencies [ms] after model load and Whisper tiny.en's real-time factor
 on espeak-ng speech (skipped when espeak-ng is missing). Targets on 2 cores: embedded
@@ -31,7 +31,7 @@ from explaindrive.language.datasets import (
     load_commands,
     load_decisions,
 )
-from explaindrive.language.encoders import DEFAULT_ENCODER, ENCODERS
+from explaindrive.language.encoders import DEFAULT_ENCODER, DEFAULT_RUNTIME, ENCODERS, RUNTIMES
 from explaindrive.language.stack import make_language_stack
 
 SENTENCES = (
@@ -54,9 +54,12 @@ def main() -> None:
     parser.add_argument(
         "--encoder", default=DEFAULT_ENCODER, choices=ENCODERS, help="LLM-1 encoder"
     )
+    parser.add_argument(
+        "--runtime", default=DEFAULT_RUNTIME, choices=RUNTIMES, help="LLM-1 encoder runtime"
+    )
     args = parser.parse_args()
     console = Console()
-    config = LanguageConfig().with_encoder(args.encoder)
+    config = LanguageConfig().with_encoder(args.encoder, args.runtime)
     stack = make_language_stack(args.backend, config)
     t0 = time.perf_counter()
     stack.interpreter.interpret("warm up")  # loads the encoder
@@ -80,8 +83,8 @@ def main() -> None:
         lat_de.append(time.perf_counter() - t)
 
     table = Table(
-        title=f"language layer, backend {args.backend}, encoder {args.encoder} "
-        f"(load {load_s:.1f} s)"
+        title=f"language layer, backend {args.backend}, encoder {args.encoder} on "
+        f"{args.runtime}, {config.embedded.encoder_threads} threads (load {load_s:.1f} s)"
     )
     for col in ("call", "n", "p50 [ms]", "p95 [ms]"):
         table.add_column(col, justify="right")

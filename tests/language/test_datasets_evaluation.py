@@ -120,8 +120,12 @@ def test_config_rejects_unknown_keys(tmp_path) -> None:  # type: ignore[no-untyp
         LanguageConfig.from_yaml(p)
     p.write_text("embedded:\n  encoder: minilm\n")
     assert LanguageConfig.from_yaml(p).embedded.encoder == "minilm"
-    p.write_text("embedded:\n  encoder: minilm\n  encoder_threads: 2\n")
+    p.write_text("embedded:\n  encoder: minilm\n  encoder_threads: 1\n")
     swapped = LanguageConfig.from_yaml(p).with_encoder("mpnet")
-    assert swapped.embedded.encoder == "mpnet" and swapped.embedded.encoder_threads == 2
+    assert swapped.embedded.encoder == "mpnet" and swapped.embedded.encoder_threads == 1
     with pytest.raises(ValueError, match="unknown sentence encoder 'bert'"):
         swapped.with_encoder("bert")
+    assert swapped.embedded.encoder_runtime == "onnx"
+    assert swapped.with_encoder("minilm", "torch").embedded.encoder_runtime == "torch"
+    with pytest.raises(ValueError, match="unknown encoder runtime 'tf'"):
+        swapped.with_encoder("minilm", "tf")

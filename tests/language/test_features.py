@@ -5,18 +5,20 @@ from __future__ import annotations
 import numpy as np
 
 from explaindrive.language.cues import N_CUES
-from explaindrive.language.features import HASH_FEATURES, FeatureSpec, features
+from explaindrive.language.features import HASH_FEATURES, FeatureSpec, SentenceEncoder, features
 
 
-def test_encoder_matches_sentence_transformers(minilm) -> None:  # type: ignore[no-untyped-def]
-    enc = minilm.encoder
+def test_both_runtimes_match_sentence_transformers(minilm) -> None:  # type: ignore[no-untyped-def]
     texts = ["could you go a bit faster", "stop", "please take it easy, I'm carrying soup"] * 30
-    ours = enc.encode(texts)  # 90 texts: two forward batches, padded differently
-    ref = enc._model.encode(texts, normalize_embeddings=True, show_progress_bar=False)
-    assert ours.shape == (90, 384) and ours.dtype == np.float32
-    np.testing.assert_allclose(ours, ref, atol=1e-5)
-    np.testing.assert_allclose(np.linalg.norm(ours, axis=1), 1.0, atol=1e-5)
-    assert enc.encode([]).shape == (0, 384)
+    torch_enc = SentenceEncoder(name="minilm", runtime="torch")
+    torch_enc.load()
+    expected = torch_enc._model.encode(texts, normalize_embeddings=True, show_progress_bar=False)
+    for enc in (minilm.encoder, torch_enc):  # the ONNX default, then PyTorch
+        ours = enc.encode(texts)  # 90 texts: two forward batches, padded differently
+        assert ours.shape == (90, 384) and ours.dtype == np.float32
+        np.testing.assert_allclose(ours, expected, atol=1e-5)
+        np.testing.assert_allclose(np.linalg.norm(ours, axis=1), 1.0, atol=1e-5)
+        assert enc.encode([]).shape == (0, 384)
 
 
 def test_feature_layout(minilm) -> None:  # type: ignore[no-untyped-def]

@@ -8,7 +8,14 @@ from typing import Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
-from explaindrive.language.encoders import DEFAULT_ENCODER, EncoderName, check_encoder
+from explaindrive.language.encoders import (
+    DEFAULT_ENCODER,
+    DEFAULT_RUNTIME,
+    EncoderName,
+    EncoderRuntime,
+    check_encoder,
+    check_runtime,
+)
 
 BackendName = Literal["embedded", "openai"]
 
@@ -53,8 +60,11 @@ class EmbeddedConfig(_Strict):
     none_margin: float | None = Field(default=None, ge=0.0, le=1.0)
     """A request is off-topic only when its off-topic probability exceeds the best command's
     by more than this; ``None`` = the value stored with the weights."""
-    encoder_threads: int = Field(default=1, ge=1)
-    """torch threads while encoding a request (1 is fastest on a CPU shared with SUMO)."""
+    encoder_runtime: EncoderRuntime = DEFAULT_RUNTIME
+    """``onnx`` (ONNX Runtime on an export cached on first use; two to three times faster)
+    or ``torch``; the embeddings agree to float rounding, so the same weights serve both."""
+    encoder_threads: int = Field(default=2, ge=1)
+    """Threads while encoding a request."""
     cutoff_m: float = Field(default=SUMMARY_CUTOFF_M, gt=0.0)
     """[m] objects farther than this are ignored by the decider and the explainer."""
 
@@ -84,13 +94,16 @@ class LanguageConfig(_Strict):
     embedded: EmbeddedConfig = EmbeddedConfig()
     openai: OpenAIConfig = OpenAIConfig()
 
-    def with_encoder(self, encoder: str) -> LanguageConfig:
-        """This config with ``embedded.encoder`` replaced.
+    def with_encoder(self, encoder: str, runtime: str | None = None) -> LanguageConfig:
+        """This config with ``embedded.encoder`` (and ``encoder_runtime``, if given) replaced.
 
         Raises:
-            ValueError: for an unknown encoder name.
+            ValueError: for an unknown encoder name or runtime.
         """
-        embedded = self.embedded.model_copy(update={"encoder": check_encoder(encoder)})
+        update: dict[str, str] = {"encoder": check_encoder(encoder)}
+        if runtime is not None:
+            update["encoder_runtime"] = check_runtime(runtime)
+        embedded = self.embedded.model_copy(update=update)
         return self.model_copy(update={"embedded": embedded})
 
     @classmethod

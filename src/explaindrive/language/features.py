@@ -24,10 +24,15 @@ from sklearn.feature_extraction.text import HashingVectorizer
 from explaindrive.language.cues import N_CUES, cue_features
 from explaindrive.language.encoders import (
     DEFAULT_ENCODER,
+    DEFAULT_RUNTIME,
     EncoderName,
+    EncoderRuntime,
+    cache_dir,
     check_encoder,
+    check_runtime,
     encoder_model_dir,
 )
+from explaindrive.language.onnx_encoder import OnnxSentenceRunner, onnx_model_file
 
 log = logging.getLogger(__name__)
 
@@ -41,49 +46,73 @@ class SentenceEncoder:
     """Lazily loaded, offline sentence-transformers encoder (unit-norm embeddings)."""
 
     def __init__(
-        self, model_dir: Path | None = None, threads: int = 1, name: EncoderName = DEFAULT_ENCODER
+        self,
+        model_dir: Path | None = None,
+        threads: int = 1,
+        name: EncoderName = DEFAULT_ENCODER,
+        runtime: EncoderRuntime = DEFAULT_RUNTIME,
     ) -> None:
         """Build an encoder (the model loads on first use).
 
         Args:
             model_dir: model directory; ``None`` = the packaged model of encoder ``name``.
-            threads: torch threads used while encoding (restored afterwards); 1 keeps
-                short sentences fast on a CPU shared with a simulation.
+            threads: threads used while encoding.
             name: which encoder (:mod:`explaindrive.language.encoders`); recorded with
                 classifier weights so they are never used with another encoder.
+            runtime: ``onnx`` (ONNX Runtime on a cached export, see
+                :mod:`explaindrive.language.onnx_encoder`) or ``torch``; both give the same
+                embeddings to float rounding.
 
         Raises:
-            ValueError: for an unknown encoder name.
+            ValueError: for an unknown encoder name or runtime.
         """
         self.model_dir = model_dir
         self.threads = threads
         self.name = check_encoder(name)
+        self.runtime = check_runtime(runtime)
         self._model: Any = None
+        self._onnx: OnnxSentenceRunner | None = None
         self._lock = threading.Lock()
 
     def load(self) -> None:
-        """Load the model now (otherwise on first use). Never touches the network."""
+        """Load the model now (otherwise on first use). Never touches the network.
+
+        Raises:
+            FileNotFoundError: if the model directory is missing.
+        """
         with self._lock:
-            if self._model is not None:
+            if self._model is not None or self._onnx is not None:
                 return
-            path = self.model_dir or encoder_model_dir(self.name)
-            if not Path(path).is_dir():
+            path = Path(self.model_dir or encoder_model_dir(self.name))
+            if not path.is_dir():
                 raise FileNotFoundError(f"sentence-embedding model directory not found: {path}")
             os.environ.setdefault("HF_HUB_OFFLINE", "1")
             os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
+            if self.runtime == "onnx":
+                log.info("loading sentence encoder %s on ONNX Runtime", path)
+                onnx_file = onnx_model_file(path, cache_dir(), self.name)
+                self._onnx = OnnxSentenceRunner(onnx_file, path, self.threads)
+                return
             from sentence_transformers import SentenceTransformer
 
             log.info("loading sentence encoder from %s", path)
             self._model = SentenceTransformer(str(path), device="cpu", local_files_only=True)
 
     def encode(self, texts: list[str]) -> NDArray[np.float32]:
-        """Embeddings of ``texts``, shape ``(len(texts), dim)``, each of unit norm.
-
-        Runs the model's own tokenizer and forward pass under ``torch.inference_mode``
-        (the same embeddings as ``SentenceTransformer.encode``, without its per-call
-        bookkeeping, which dominates for the single short sentences of a ride).
-        """
+        """Embeddings of ``texts``, shape ``(len(texts), dim)``, each of unit norm."""
         self.load()
+        if self._onnx is not None:
+            runner = self._onnx
+            parts = [
+                runner.embed(texts[i : i + ENCODE_BATCH])
+                for i in range(0, len(texts), ENCODE_BATCH)
+            ]
+            return np.vstack(parts) if parts else runner.embed([])
+        return self._encode_torch(texts)
+
+    def _encode_torch(self, texts: list[str]) -> NDArray[np.float32]:
+        """The model's own tokenizer and forward pass under ``torch.inference_mode`` (the
+        embeddings of ``SentenceTransformer.encode`` without its per-call bookkeeping)."""
         import torch
 
         model = self._model

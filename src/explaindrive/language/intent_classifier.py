@@ -41,7 +41,13 @@ from explaindrive.language.datasets import (
     data_path,
     load_commands,
 )
-from explaindrive.language.encoders import DEFAULT_ENCODER, ENCODERS, check_encoder
+from explaindrive.language.encoders import (
+    DEFAULT_ENCODER,
+    DEFAULT_RUNTIME,
+    ENCODERS,
+    RUNTIMES,
+    check_encoder,
+)
 from explaindrive.language.features import (
     FeatureSpec,
     SentenceEncoder,
@@ -465,6 +471,12 @@ def main(argv: list[str] | None = None) -> None:
         "--encoder", choices=ENCODERS, default=DEFAULT_ENCODER, help="sentence encoder"
     )
     parser.add_argument(
+        "--runtime",
+        choices=RUNTIMES,
+        default=DEFAULT_RUNTIME,
+        help="encoder runtime (the embeddings agree to float rounding)",
+    )
+    parser.add_argument(
         "--out", type=Path, default=None, help="weights file (default: the shipped one)"
     )
     args = parser.parse_args(argv)
@@ -472,7 +484,7 @@ def main(argv: list[str] | None = None) -> None:
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     train_rows = load_commands(args.train)
     dev_rows = [load_commands(p) for p in args.dev]
-    clf, _ = train(train_rows, dev_rows, SentenceEncoder(name=args.encoder))
+    clf, _ = train(train_rows, dev_rows, SentenceEncoder(name=args.encoder, runtime=args.runtime))
     clf.save(out)
     log.info(
         "wrote %s (%d training + %d development requests)",

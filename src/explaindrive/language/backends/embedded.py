@@ -36,7 +36,10 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         """Args: config: backend options; encoder: share one loaded encoder between users."""
         self.config = config or EmbeddedConfig()
         self.encoder = encoder or SentenceEncoder(
-            self.config.embedding_model_dir, self.config.encoder_threads, self.config.encoder
+            self.config.embedding_model_dir,
+            self.config.encoder_threads,
+            self.config.encoder,
+            self.config.encoder_runtime,
         )
         self.classifier = IntentClassifier.load(self.config.classifier_path, self.encoder.name)
 
