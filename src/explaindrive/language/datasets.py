@@ -68,10 +68,13 @@ evaluated once by each; never used to build them."""
 TEST7_CSV = "commands_test7.csv"
 """Held-out requests of round 12, written after the shipped models were built and evaluated
 once by each; never used to build them."""
-TEST_CSV = "commands_test8.csv"
+TEST8_CSV = "commands_test8.csv"
 """Held-out requests of round 13, written after the shipped models were built and evaluated
 once by each; never used to build them."""
-TEST_SPLITS: tuple[str, ...] = (TEST6_CSV, TEST7_CSV, TEST_CSV)
+TEST_CSV = "commands_test9.csv"
+"""Held-out requests of round 14, written after the shipped models were built and evaluated
+once by each; never used to build them."""
+TEST_SPLITS: tuple[str, ...] = (TEST6_CSV, TEST7_CSV, TEST8_CSV, TEST_CSV)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 """The shipped LLM-1 weights over all-MiniLM-L6-v2."""
