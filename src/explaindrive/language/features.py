@@ -25,6 +25,7 @@ from explaindrive.language.cues import N_CUES, cue_features
 from explaindrive.language.encoders import (
     DEFAULT_ENCODER,
     DEFAULT_RUNTIME,
+    RUNTIME_THREADS,
     EncoderName,
     EncoderRuntime,
     cache_dir,
@@ -48,7 +49,7 @@ class SentenceEncoder:
     def __init__(
         self,
         model_dir: Path | None = None,
-        threads: int = 1,
+        threads: int | None = None,
         name: EncoderName = DEFAULT_ENCODER,
         runtime: EncoderRuntime = DEFAULT_RUNTIME,
     ) -> None:
@@ -56,7 +57,8 @@ class SentenceEncoder:
 
         Args:
             model_dir: model directory; ``None`` = the packaged model of encoder ``name``.
-            threads: threads used while encoding.
+            threads: threads used while encoding; ``None`` = the runtime's default
+                (:data:`~explaindrive.language.encoders.RUNTIME_THREADS`).
             name: which encoder (:mod:`explaindrive.language.encoders`); recorded with
                 classifier weights so they are never used with another encoder.
             runtime: ``onnx`` (ONNX Runtime on a cached export, see
@@ -67,9 +69,9 @@ class SentenceEncoder:
             ValueError: for an unknown encoder name or runtime.
         """
         self.model_dir = model_dir
-        self.threads = threads
         self.name = check_encoder(name)
         self.runtime = check_runtime(runtime)
+        self.threads = RUNTIME_THREADS[self.runtime] if threads is None else threads
         self._model: Any = None
         self._onnx: OnnxSentenceRunner | None = None
         self._lock = threading.Lock()

@@ -43,9 +43,9 @@ from explaindrive.language.datasets import (
 )
 from explaindrive.language.encoders import (
     DEFAULT_ENCODER,
-    DEFAULT_RUNTIME,
     ENCODERS,
     RUNTIMES,
+    EncoderRuntime,
     check_encoder,
 )
 from explaindrive.language.features import (
@@ -60,6 +60,9 @@ log = logging.getLogger(__name__)
 STOP = INTENT_LABELS.index("stop")
 NONE = INTENT_LABELS.index("none")
 KNN_TEMPERATURE = 0.05  # softmax temperature over per-class best cosine similarities
+BUILD_RUNTIME: EncoderRuntime = "torch"
+"""The runtime whose embeddings the shipped weights were built from. ONNX embeddings agree
+to float rounding, which can still move a tuned threshold by one grid step."""
 STOP_MISS_COST = 5.0  # a missed STOP costs this many false STOPs when tuning the threshold
 MAX_STOP_THRESHOLD = 0.5
 MIN_STOP_THRESHOLD = 0.1
@@ -473,8 +476,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--runtime",
         choices=RUNTIMES,
-        default=DEFAULT_RUNTIME,
-        help="encoder runtime (the embeddings agree to float rounding)",
+        default=BUILD_RUNTIME,
+        help="encoder runtime of the training embeddings (default: the one the shipped "
+        "weights were built with)",
     )
     parser.add_argument(
         "--out", type=Path, default=None, help="weights file (default: the shipped one)"
