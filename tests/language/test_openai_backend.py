@@ -101,3 +101,16 @@ def test_explanation_grounding(openai_server) -> None:  # type: ignore[no-untype
     assert openai_server.requests[0]["temperature"] == 0.2
     e = ex.explain(RED, Factor.TRAFFIC_LIGHT)
     assert e.fallback and "pedestrian" in (e.error or "") and "30 m" in e.text
+
+
+def test_loading_the_openai_stack_loads_the_offline_fallback() -> None:
+    from explaindrive.language.config import LanguageConfig
+    from explaindrive.language.stack import make_language_stack
+
+    config = LanguageConfig().with_encoder("minilm")
+    stack = make_language_stack("openai", config)
+    assert isinstance(stack.interpreter, OpenAIIntentInterpreter)
+    encoder = stack.interpreter.fallback.encoder
+    assert encoder._onnx is None  # lazy until loaded
+    stack.load()  # a ride calls this before it starts
+    assert encoder._onnx is not None

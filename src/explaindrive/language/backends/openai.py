@@ -143,6 +143,11 @@ class OpenAIIntentInterpreter(IntentInterpreter):
         self.client = client
         self.fallback = fallback
 
+    def load(self) -> None:
+        """Load the fallback's sentence encoder now, so that the first failed request is
+        answered without paying the model load."""
+        self.fallback.load()
+
     def interpret(self, text: str) -> IntentResult:
         """Ask the endpoint; the reply must be exactly the confirmation template."""
         t0 = time.perf_counter()
