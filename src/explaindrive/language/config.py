@@ -64,8 +64,7 @@ class EmbeddedConfig(_Strict):
     """``onnx`` (ONNX Runtime on an export cached on first use; two to three times faster)
     or ``torch``; the embeddings agree to float rounding, so the same weights serve both."""
     encoder_threads: int | None = Field(default=None, ge=1)
-    """Threads while encoding a request; ``None`` = 2 on ``onnx``, 1 on ``torch`` (the
-    fastest of each on 2 cores)."""
+    """Threads while encoding a request; ``None`` = 2 on ``onnx``, 1 on ``torch``."""
     cutoff_m: float = Field(default=SUMMARY_CUTOFF_M, gt=0.0)
     """[m] objects farther than this are ignored by the decider and the explainer."""
 

