@@ -95,3 +95,17 @@ def test_a_folder_that_is_not_a_model_is_refused(tmp_path: Path) -> None:
         export_onnx(tmp_path, tmp_path / "out")
     with pytest.raises(FileNotFoundError, match="model directory not found"):
         SentenceEncoder(tmp_path / "missing", name="minilm").load()
+
+
+def test_an_exporter_failure_names_the_way_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import torch
+
+    def broken(*_: object, **__: object) -> None:
+        raise NotImplementedError("no exporter here")
+
+    monkeypatch.setattr(torch.onnx, "export", broken)
+    with pytest.raises(RuntimeError, match=r"NotImplementedError: no exporter here.*torch"):
+        export_onnx(minilm_model_dir(), tmp_path / "onnx" / "minilm-test")
+    assert list((tmp_path / "onnx").iterdir()) == []

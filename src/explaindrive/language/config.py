@@ -61,7 +61,7 @@ class EmbeddedConfig(_Strict):
     """A request is off-topic only when its off-topic probability exceeds the best command's
     by more than this; ``None`` = the value stored with the weights."""
     encoder_runtime: EncoderRuntime = DEFAULT_RUNTIME
-    """``onnx`` (ONNX Runtime on an export cached on first use; two to three times faster)
+    """``onnx`` (ONNX Runtime on an export cached on first use; about twice as fast)
     or ``torch``; the embeddings agree to float rounding, so the same weights serve both."""
     encoder_threads: int | None = Field(default=None, ge=1)
     """Threads while encoding a request; ``None`` = 2 on ``onnx``, 1 on ``torch``."""

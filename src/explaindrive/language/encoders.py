@@ -44,15 +44,19 @@ _REQUIRED_FILES = ("config.json", "modules.json", "model.safetensors", "tokenize
 _COMPLETE_MARK = ".complete"
 
 
+def _one_of(name: str, choices: tuple[str, ...], what: str) -> str:
+    if name not in choices:
+        raise ValueError(f"unknown {what} {name!r}; choose one of {', '.join(choices)}")
+    return name
+
+
 def check_encoder(name: str) -> EncoderName:
     """``name`` as an encoder name.
 
     Raises:
         ValueError: for an unknown name.
     """
-    if name not in ENCODERS:
-        raise ValueError(f"unknown sentence encoder {name!r}; choose one of {', '.join(ENCODERS)}")
-    return name  # type: ignore[return-value]
+    return _one_of(name, ENCODERS, "sentence encoder")  # type: ignore[return-value]
 
 
 def check_runtime(name: str) -> EncoderRuntime:
@@ -61,9 +65,7 @@ def check_runtime(name: str) -> EncoderRuntime:
     Raises:
         ValueError: for an unknown name.
     """
-    if name not in RUNTIMES:
-        raise ValueError(f"unknown encoder runtime {name!r}; choose one of {', '.join(RUNTIMES)}")
-    return name  # type: ignore[return-value]
+    return _one_of(name, RUNTIMES, "encoder runtime")  # type: ignore[return-value]
 
 
 def encoder_model_dir(name: str) -> Path:

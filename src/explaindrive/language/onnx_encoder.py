@@ -1,8 +1,8 @@
 """The sentence encoders of LLM-1 on ONNX Runtime.
 
 A sentence-transformers model (transformer, mean pooling, normalisation) is exported once
-to ONNX into the cache directory and then run by ONNX Runtime, which is two to three times
-faster than PyTorch for the single short sentences of a ride. The embeddings are the same
+to ONNX into the cache directory and then run by ONNX Runtime, about twice as fast as
+PyTorch for the single short sentences of a ride. The embeddings are the same
 as PyTorch's to float rounding (the export is checked against PyTorch before it is kept),
 so the classifier weights serve both runtimes.
 """
@@ -56,7 +56,7 @@ def onnx_model_file(model_dir: Path, root: Path, label: str) -> Path:
 
     Raises:
         FileNotFoundError: if ``model_dir`` is not a sentence-transformers model.
-        RuntimeError: if the export does not reproduce PyTorch's embeddings.
+        RuntimeError: if the export fails or does not reproduce PyTorch's embeddings.
     """
     target = export_dir(model_dir, root, label)
     if (target / _COMPLETE_MARK).is_file():
@@ -73,7 +73,7 @@ def export_onnx(model_dir: Path, target: Path) -> Path:
 
     Raises:
         FileNotFoundError: if ``model_dir`` is not a sentence-transformers model.
-        RuntimeError: if the export does not reproduce PyTorch's embeddings.
+        RuntimeError: if the export fails or does not reproduce PyTorch's embeddings.
     """
     if not (model_dir / "modules.json").is_file():
         raise FileNotFoundError(f"not a sentence-transformers model directory: {model_dir}")
@@ -101,22 +101,28 @@ def export_onnx(model_dir: Path, target: Path) -> Path:
     with tempfile.TemporaryDirectory(dir=target.parent, prefix=f".{target.name}-") as tmp:
         staged = Path(tmp) / target.name
         staged.mkdir()
-        with warnings.catch_warnings():  # tracer notes on branches fixed for this model
-            warnings.simplefilter("ignore")
-            torch.onnx.export(
-                _Embed(),
-                args,
-                str(staged / ONNX_FILE),
-                input_names=["input_ids", "attention_mask"],
-                output_names=["embedding"],
-                dynamic_axes={
-                    "input_ids": {0: "batch", 1: "tokens"},
-                    "attention_mask": {0: "batch", 1: "tokens"},
-                    "embedding": {0: "batch"},
-                },
-                opset_version=17,
-                dynamo=False,
-            )
+        try:
+            with warnings.catch_warnings():  # tracer notes on branches fixed for this model
+                warnings.simplefilter("ignore")
+                torch.onnx.export(
+                    _Embed(),
+                    args,
+                    str(staged / ONNX_FILE),
+                    input_names=["input_ids", "attention_mask"],
+                    output_names=["embedding"],
+                    dynamic_axes={
+                        "input_ids": {0: "batch", 1: "tokens"},
+                        "attention_mask": {0: "batch", 1: "tokens"},
+                        "embedding": {0: "batch"},
+                    },
+                    opset_version=17,
+                    dynamo=False,
+                )
+        except Exception as exc:  # any exporter failure: say what to do instead
+            raise RuntimeError(
+                f"exporting {model_dir} to ONNX failed ({type(exc).__name__}: {exc}); "
+                "use encoder_runtime: torch"
+            ) from exc
         got = OnnxSentenceRunner(staged / ONNX_FILE, model_dir, threads=1).embed(list(_PROBES))
         worst = float(np.max(np.abs(got - expected)))
         if worst > EXPORT_TOLERANCE:
