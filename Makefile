@@ -37,7 +37,7 @@ lint:
 	$(BIN)/mypy
 
 bench:
-	$(BIN)/python benchmarks/bench_env.py
+	for b in benchmarks/bench_*.py; do echo "== $$b"; $(BIN)/python $$b || exit 1; done
 
 clean:
 	rm -rf $(VENV) build dist *.egg-info
