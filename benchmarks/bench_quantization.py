@@ -27,11 +27,11 @@ from onnxruntime.quantization import QuantType, quantize_dynamic
 from rich.console import Console
 from rich.table import Table
 
+from explaindrive.cache import cache_dir
 from explaindrive.language.datasets import TEST_CSV, data_path, load_commands
 from explaindrive.language.encoders import (
     DEFAULT_ENCODER,
     ENCODERS,
-    cache_dir,
     encoder_model_dir,
 )
 from explaindrive.language.features import normalize_text

@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
+from explaindrive.cache import cache_dir
 from explaindrive.language import onnx_encoder
 from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
 from explaindrive.language.config import EmbeddedConfig
 from explaindrive.language.datasets import DEV_SPLITS, data_path, load_commands
-from explaindrive.language.encoders import cache_dir, check_runtime, minilm_model_dir
+from explaindrive.language.encoders import check_runtime, minilm_model_dir
 from explaindrive.language.features import SentenceEncoder, normalize_text
 from explaindrive.language.onnx_encoder import export_dir, export_onnx, onnx_model_file
 

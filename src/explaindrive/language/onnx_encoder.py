@@ -12,8 +12,6 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import os
-import shutil
 import tempfile
 import threading
 import warnings
@@ -22,6 +20,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from explaindrive.cache import is_complete, publish
 
 log = logging.getLogger(__name__)
 
@@ -33,7 +33,6 @@ _PROBES = (
     "stop",
     "Could you take the next corner a little more gently? My coffee is about to spill.",
 )
-_COMPLETE_MARK = ".complete"
 
 
 def export_dir(model_dir: Path, root: Path, label: str) -> Path:
@@ -59,7 +58,7 @@ def onnx_model_file(model_dir: Path, root: Path, label: str) -> Path:
         RuntimeError: if the export fails or does not reproduce PyTorch's embeddings.
     """
     target = export_dir(model_dir, root, label)
-    if (target / _COMPLETE_MARK).is_file():
+    if is_complete(target):
         return target / ONNX_FILE
     return export_onnx(Path(model_dir), target) / ONNX_FILE
 
@@ -130,14 +129,7 @@ def export_onnx(model_dir: Path, target: Path) -> Path:
                 f"the ONNX export of {model_dir} differs from PyTorch by {worst:.2e} "
                 f"(> {EXPORT_TOLERANCE:g}); use encoder_runtime: torch"
             )
-        (staged / _COMPLETE_MARK).write_text(f"max |onnx - torch| = {worst:.3e}\n")
-        try:
-            os.replace(staged, target)
-        except OSError:
-            if not (target / _COMPLETE_MARK).is_file():
-                raise
-            shutil.rmtree(staged, ignore_errors=True)  # another process finished first
-    return target
+        return publish(staged, target, f"max |onnx - torch| = {worst:.3e}\n")
 
 
 def load_tokenizer(model_dir: Path) -> Any:

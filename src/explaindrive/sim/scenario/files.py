@@ -10,6 +10,7 @@ from importlib import resources
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
+from explaindrive.cache import cache_dir as user_cache_dir
 from explaindrive.sim.scenario import layout
 
 EGO_ROUTE_ID = "ego_route"
@@ -23,13 +24,6 @@ FLOW_END_S = 4_000  # [s] flows outlast warm-up plus the longest episode
 def package_data_dir() -> Path:
     """Directory of the committed scenario files inside the package."""
     return Path(str(resources.files("explaindrive.sim.scenario") / "data"))
-
-
-def default_cache_dir() -> Path:
-    """Per-user cache for generated demand files and warm-up states."""
-    base = os.environ.get("EXPLAINDRIVE_CACHE") or os.environ.get("XDG_CACHE_HOME")
-    root = Path(base) if base else Path.home() / ".cache"
-    return (root / "explaindrive") if not os.environ.get("EXPLAINDRIVE_CACHE") else root
 
 
 def _fmt(x: float) -> str:
@@ -123,5 +117,5 @@ def default_scenario(cache_dir: Path | None = None) -> ScenarioFiles:
     """The shipped urban scenario."""
     return ScenarioFiles(
         net_file=package_data_dir() / "urban.net.xml",
-        cache_dir=cache_dir or default_cache_dir(),
+        cache_dir=cache_dir or user_cache_dir(),
     )
