@@ -35,8 +35,8 @@ from explaindrive.language.encoders import (
     DEFAULT_ENCODER,
     DEFAULT_RUNTIME,
     ENCODERS,
-    RUNTIME_THREADS,
     RUNTIMES,
+    encoder_threads,
 )
 from explaindrive.language.stack import make_language_stack
 
@@ -88,7 +88,7 @@ def main() -> None:
             stack.explainer.explain(rec, d.factor)
         lat_de.append(time.perf_counter() - t)
 
-    threads = config.embedded.encoder_threads or RUNTIME_THREADS[args.runtime]
+    threads = encoder_threads(args.runtime, config.embedded.encoder_threads)
     table = Table(
         title=f"language layer, backend {args.backend}, encoder {args.encoder} on "
         f"{args.runtime}, {threads} threads (load {load_s:.1f} s)"

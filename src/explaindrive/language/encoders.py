@@ -67,6 +67,15 @@ def check_runtime(name: str) -> EncoderRuntime:
     return _one_of(name, RUNTIMES, "encoder runtime")  # type: ignore[return-value]
 
 
+def encoder_threads(runtime: str, threads: int | None = None) -> int:
+    """``threads`` if given, else the default of ``runtime`` (:data:`RUNTIME_THREADS`).
+
+    Raises:
+        ValueError: for an unknown runtime.
+    """
+    return RUNTIME_THREADS[check_runtime(runtime)] if threads is None else threads
+
+
 def encoder_model_dir(name: str) -> Path:
     """The model directory of encoder ``name``, ready for ``SentenceTransformer``.
 

@@ -26,12 +26,12 @@ from explaindrive.language.cues import N_CUES, cue_features
 from explaindrive.language.encoders import (
     DEFAULT_ENCODER,
     DEFAULT_RUNTIME,
-    RUNTIME_THREADS,
     EncoderName,
     EncoderRuntime,
     check_encoder,
     check_runtime,
     encoder_model_dir,
+    encoder_threads,
 )
 from explaindrive.language.onnx_encoder import OnnxSentenceRunner, onnx_model_file
 
@@ -71,7 +71,7 @@ class SentenceEncoder:
         self.model_dir = model_dir
         self.name = check_encoder(name)
         self.runtime = check_runtime(runtime)
-        self.threads = RUNTIME_THREADS[self.runtime] if threads is None else threads
+        self.threads = encoder_threads(self.runtime, threads)
         self._model: Any = None
         self._onnx: OnnxSentenceRunner | None = None
         self._lock = threading.Lock()
