@@ -251,7 +251,7 @@ def test_a_ride_that_cannot_start():
 
 
 def test_real_stack_checks_backend_and_encoder() -> None:
-    with pytest.raises(ValueError, match="backend must be"):
+    with pytest.raises(ValueError, match="unknown language backend"):
         RealStack("gpt9")
     with pytest.raises(ValueError, match="unknown sentence encoder 'bert'"):
         RealStack("embedded", "bert")

@@ -6,6 +6,7 @@ import typer
 from rich.console import Console
 
 from explaindrive.cli._language_common import ENCODER_HELP
+from explaindrive.language.backends import check_backend
 from explaindrive.language.encoders import DEFAULT_ENCODER, check_encoder
 
 console = Console()
@@ -33,11 +34,9 @@ def serve(
 
     from explaindrive.web import create_app
 
-    if backend not in ("embedded", "openai"):
-        console.print(f"[red]error:[/red] unknown backend {backend!r}; use embedded or openai")
-        raise typer.Exit(2)
-    try:
-        check_encoder(encoder)  # before the server starts
+    try:  # before the server starts
+        check_backend(backend)
+        check_encoder(encoder)
     except ValueError as exc:
         console.print(f"[red]error:[/red] {exc}")
         raise typer.Exit(2) from exc

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from explaindrive.language.backends import check_backend
 from explaindrive.sim.scenario.layout import validate_traffic_level
 
 
@@ -55,5 +56,4 @@ class RideConfig:
         ):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
-        if self.backend not in ("embedded", "openai"):
-            raise ValueError(f"backend must be 'embedded' or 'openai', got {self.backend!r}")
+        check_backend(self.backend)

@@ -27,6 +27,7 @@ from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from starlette.datastructures import UploadFile
 
+from explaindrive.language.backends import check_backend
 from explaindrive.language.encoders import DEFAULT_ENCODER, check_encoder
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
@@ -60,9 +61,7 @@ class RealStack:
     """
 
     def __init__(self, backend: str = "embedded", encoder: str = DEFAULT_ENCODER) -> None:
-        if backend not in ("embedded", "openai"):
-            raise ValueError(f"backend must be 'embedded' or 'openai', got {backend!r}")
-        self.backend = backend
+        self.backend = check_backend(backend)
         self.encoder = check_encoder(encoder)
         self._controller: Any = None
         self._language: Any = None

@@ -1,0 +1,25 @@
+"""``explaindrive serve`` refuses bad names before a server starts."""
+
+from __future__ import annotations
+
+import typer
+from typer.testing import CliRunner
+
+from explaindrive.cli import serve
+
+app = typer.Typer()
+serve.register(app)
+app.command("noop")(lambda: None)  # two commands, so Typer keeps the sub-command name
+runner = CliRunner()
+
+
+def test_unknown_backend_exits_before_serving() -> None:
+    res = runner.invoke(app, ["serve", "--backend", "gpt"])
+    assert res.exit_code == 2
+    assert "unknown language backend 'gpt'" in res.output
+
+
+def test_unknown_encoder_exits_before_serving() -> None:
+    res = runner.invoke(app, ["serve", "--encoder", "bert"])
+    assert res.exit_code == 2
+    assert "unknown sentence encoder 'bert'" in res.output
