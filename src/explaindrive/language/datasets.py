@@ -49,6 +49,14 @@ DEV9_CSV = "commands_dev9.csv"
 """Ninth development split (the round-9 test split, evaluated by the round-9 model)."""
 DEV10_CSV = "commands_dev10.csv"
 """Tenth development split (the round-10 test split, evaluated by the round-10 model)."""
+DEV11_CSV = "commands_dev11.csv"
+"""The round-11 test split, evaluated once by the round-11 MiniLM and mpnet models."""
+DEV12_CSV = "commands_dev12.csv"
+"""The round-12 test split, evaluated once by the round-11 models and a withdrawn cascade."""
+DEV13_CSV = "commands_dev13.csv"
+"""The round-13 test split, evaluated once by the round-11 models."""
+DEV14_CSV = "commands_dev14.csv"
+"""The round-14 test split, evaluated once by the round-11 models."""
 DEV_SPLITS: tuple[str, ...] = (
     DEV_CSV,
     DEV2_CSV,
@@ -60,21 +68,16 @@ DEV_SPLITS: tuple[str, ...] = (
     DEV8_CSV,
     DEV9_CSV,
     DEV10_CSV,
+    DEV11_CSV,
+    DEV12_CSV,
+    DEV13_CSV,
+    DEV14_CSV,
 )
 """The development splits, each written in its own round; LLM-1 selection holds each out."""
-TEST6_CSV = "commands_test6.csv"
-"""Held-out requests of round 11, written before the shipped MiniLM and mpnet models and
-evaluated once by each; never used to build them."""
-TEST7_CSV = "commands_test7.csv"
-"""Held-out requests of round 12, written after the shipped models were built and evaluated
-once by each; never used to build them."""
-TEST8_CSV = "commands_test8.csv"
-"""Held-out requests of round 13, written after the shipped models were built and evaluated
-once by each; never used to build them."""
-TEST_CSV = "commands_test9.csv"
-"""Held-out requests of round 14, written after the shipped models were built and evaluated
-once by each; never used to build them."""
-TEST_SPLITS: tuple[str, ...] = (TEST6_CSV, TEST7_CSV, TEST8_CSV, TEST_CSV)
+TEST_CSV = "commands_test10.csv"
+"""Held-out requests of round 15, written from the labelling guide alone and committed
+before any model judged on it was evaluated; never used to build a shipped model."""
+TEST_SPLITS: tuple[str, ...] = (TEST_CSV,)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 """The shipped LLM-1 weights over all-MiniLM-L6-v2."""
