@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_language.py [--backend embedded|openai] [--n 200]
-        [--encoder mpnet|minilm] [--runtime onnx|torch]
+        [--encoder minilm|mpnet] [--runtime onnx|torch]
 
 Prints p50/p95 latencies [ms] after model load and Whisper tiny.en's real-time factor
 on espeak-ng speech (skipped when espeak-ng is missing). Targets on 2 cores: embedded

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_quantization.py [--encoder mpnet|minilm] [--n 150]
+    python benchmarks/bench_quantization.py [--encoder minilm|mpnet] [--n 150]
 
 Quantizes the cached ONNX export of the encoder with ONNX Runtime's dynamic int8
 quantization, once with every weight matrix product and once with the feed-forward output

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python scripts/compare_encoder_runtimes.py [--encoder mpnet|minilm]
+    python scripts/compare_encoder_runtimes.py [--encoder minilm|mpnet]
 
 Encodes every request of the development and test splits with both runtimes and prints
 the largest embedding difference, the lowest cosine, whether the token ids agree, and how

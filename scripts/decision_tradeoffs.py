@@ -2,7 +2,7 @@
 
 Usage::
 
-    python scripts/decision_tradeoffs.py [--encoder mpnet|minilm] [--runtime torch|onnx]
+    python scripts/decision_tradeoffs.py [--encoder minilm|mpnet] [--runtime torch|onnx]
 
 Rebuilds the held-out probabilities the shipped model's settings were tuned on (each of
 the ten development splits predicted by a model fitted on the training requests and the

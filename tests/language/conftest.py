@@ -22,16 +22,16 @@ from explaindrive.language.speech import Transcriber
 
 @pytest.fixture(scope="session")
 def interpreter() -> EmbeddedIntentInterpreter:
-    """The default embedded LLM-1 (mpnet), its encoder loaded once for the whole session."""
+    """The default embedded LLM-1 (MiniLM), its encoder loaded once for the whole session."""
     it = EmbeddedIntentInterpreter()
     it.load()
     return it
 
 
 @pytest.fixture(scope="session")
-def minilm() -> EmbeddedIntentInterpreter:
-    """The embedded LLM-1 over all-MiniLM-L6-v2, loaded once for the whole session."""
-    it = EmbeddedIntentInterpreter(EmbeddedConfig(encoder="minilm"))
+def mpnet() -> EmbeddedIntentInterpreter:
+    """The embedded LLM-1 over all-mpnet-base-v2, loaded once for the whole session."""
+    it = EmbeddedIntentInterpreter(EmbeddedConfig(encoder="mpnet"))
     it.load()
     return it
 

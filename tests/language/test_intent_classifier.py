@@ -120,16 +120,16 @@ def test_select_returns_a_grid_point_and_its_held_out_figures() -> None:
 def test_weights_round_trip_and_remember_their_encoder(tmp_path) -> None:  # type: ignore[no-untyped-def]
     train, devs = _toy(0, 24), [_toy(1), _toy(2)]
     grid = {"c": (10.0,), "ngram_weight": (1.0,), "cue_weight": (0.0,), "lr_weight": (0.5,)}
-    clf = fit_final(train, devs, select(train, devs, grid), encoder="minilm")
+    clf = fit_final(train, devs, select(train, devs, grid), encoder="mpnet")
     path = tmp_path / "clf.npz"
     clf.save(path)
-    back = IntentClassifier.load(path, encoder="minilm")
-    assert back.spec == clf.spec and back.spec.encoder == "minilm"
+    back = IntentClassifier.load(path, encoder="mpnet")
+    assert back.spec == clf.spec and back.spec.encoder == "mpnet"
     np.testing.assert_array_equal(back.coef, clf.coef)
     x = Encoded.concat(devs).features(clf.spec)
     np.testing.assert_allclose(back.proba(x), clf.proba(x), atol=1e-3)  # float16 references
-    with pytest.raises(ValueError, match="built over the 'minilm' encoder's embeddings"):
-        IntentClassifier.load(path)  # the default encoder is mpnet
+    with pytest.raises(ValueError, match="built over the 'mpnet' encoder's embeddings"):
+        IntentClassifier.load(path)  # the default encoder is MiniLM
     (tmp_path / "junk.npz").write_bytes(b"not numpy")
     with pytest.raises(ValueError, match="not a valid intent classifier file"):
         IntentClassifier.load(tmp_path / "junk.npz")

@@ -35,18 +35,18 @@ def test_runtime_names() -> None:
 
 
 def test_onnx_matches_torch_on_requests_and_overlong_text(
-    minilm: EmbeddedIntentInterpreter,
+    interpreter: EmbeddedIntentInterpreter,
 ) -> None:
-    assert minilm.encoder.runtime == "onnx"
+    assert interpreter.encoder.runtime == "onnx"
     texts = [normalize_text(r.text) for r in load_commands(data_path(DEV_SPLITS[0]))[:40]]
     texts += ["", LONG]
     torch_encoder = SentenceEncoder(name="minilm", runtime="torch")
-    onnx_emb = minilm.encoder.encode(texts)
+    onnx_emb = interpreter.encoder.encode(texts)
     assert float(np.max(np.abs(onnx_emb - torch_encoder.encode(texts)))) < 1e-5
     # one sentence at a time, as in a ride, gives the batch's embeddings
-    single = np.vstack([minilm.encoder.encode([t]) for t in texts[:5]])
+    single = np.vstack([interpreter.encoder.encode([t]) for t in texts[:5]])
     assert float(np.max(np.abs(single - onnx_emb[:5]))) < 1e-5
-    runner = minilm.encoder._onnx
+    runner = interpreter.encoder._onnx
     assert runner is not None
     prepare = torch_encoder._model.preprocess
     for text in (texts[0], LONG):
@@ -56,7 +56,7 @@ def test_onnx_matches_torch_on_requests_and_overlong_text(
 
 
 def test_export_is_kept_and_reused(
-    minilm: EmbeddedIntentInterpreter, monkeypatch: pytest.MonkeyPatch
+    interpreter: EmbeddedIntentInterpreter, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     target = export_dir(minilm_model_dir(), cache_dir(), "minilm")
     assert (target / onnx_encoder.ONNX_FILE).is_file()

@@ -1,4 +1,4 @@
-"""The two shipped LLM-1 models: mpnet (the default) and MiniLM."""
+"""The two shipped LLM-1 models: MiniLM (the default) and mpnet."""
 
 from __future__ import annotations
 
@@ -15,15 +15,15 @@ from explaindrive.ride.script import default_script_path, load_script
 DIMENSIONS = {"mpnet": 768, "minilm": 384}
 
 
-@pytest.fixture(params=["interpreter", "minilm"])
+@pytest.fixture(params=["interpreter", "mpnet"])
 def model(request: pytest.FixtureRequest) -> EmbeddedIntentInterpreter:
     """Each shipped model in turn (the session fixtures of conftest)."""
     it: EmbeddedIntentInterpreter = request.getfixturevalue(request.param)
     return it
 
 
-def test_default_is_mpnet(interpreter: EmbeddedIntentInterpreter) -> None:
-    assert interpreter.encoder.name == "mpnet" and interpreter.classifier.spec.encoder == "mpnet"
+def test_default_is_minilm(interpreter: EmbeddedIntentInterpreter) -> None:
+    assert interpreter.encoder.name == "minilm" and interpreter.classifier.spec.encoder == "minilm"
 
 
 def test_encoder_and_weights_match(model: EmbeddedIntentInterpreter) -> None:

@@ -102,7 +102,7 @@ def test_openai_backend_that_times_out_falls_back(tmp_path: Path) -> None:
     assert len(session.records) == 12
 
 
-def test_ride_with_the_minilm_encoder_reads_the_default_script(tmp_path: Path) -> None:
+def test_ride_with_the_mpnet_encoder_reads_the_default_script(tmp_path: Path) -> None:
     from typer.testing import CliRunner
 
     from explaindrive.cli.main import app
@@ -110,9 +110,9 @@ def test_ride_with_the_minilm_encoder_reads_the_default_script(tmp_path: Path) -
     runner = CliRunner()
     res = runner.invoke(app, ["ride", "--encoder", "bert", "--no-live", "--out", str(tmp_path)])
     assert res.exit_code == 2 and "unknown sentence encoder 'bert'" in res.output
-    out = tmp_path / "minilm"
+    out = tmp_path / "mpnet"
     res = runner.invoke(
-        app, ["ride", "--encoder", "minilm", "--no-live", "--max-steps", "120", "--out", str(out)]
+        app, ["ride", "--encoder", "mpnet", "--no-live", "--max-steps", "120", "--out", str(out)]
     )
     assert res.exit_code == 0, res.output
     steps = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]

@@ -16,7 +16,7 @@ err_console = Console(stderr=True)
 
 BACKEND_HELP = "Language backend: embedded (offline, default) or openai."
 CONFIG_HELP = "YAML language config (see docs/language.md)."
-ENCODER_HELP = "LLM-1 sentence encoder of the embedded backend: mpnet (default) or minilm."
+ENCODER_HELP = "LLM-1 sentence encoder of the embedded backend: minilm (default) or mpnet."
 
 
 def load_config(path: Path | None, encoder: str | None = None) -> LanguageConfig:

@@ -47,8 +47,9 @@ class EmbeddedConfig(_Strict):
     """Offline backend: sentence embeddings + shipped classifier, rule engine, templates."""
 
     encoder: EncoderName = DEFAULT_ENCODER
-    """Sentence encoder of LLM-1: ``mpnet`` (all-mpnet-base-v2, default) or ``minilm``
-    (all-MiniLM-L6-v2: about four times faster, more errors; see docs/language.md)."""
+    """Sentence encoder of LLM-1: ``minilm`` (all-MiniLM-L6-v2, default) or ``mpnet``
+    (all-mpnet-base-v2: about four times slower, fewer held-out errors; see
+    docs/language.md)."""
     embedding_model_dir: Path | None = None
     """sentence-transformers model directory; ``None`` = the encoder's packaged model."""
     classifier_path: Path | None = None

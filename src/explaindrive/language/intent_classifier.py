@@ -15,8 +15,8 @@ off-topic only when its off-topic probability leads the best command's by more t
 ``COMMAND_DROP_COST`` off-topic requests answered with a confirmation question. Retrain
 and re-ship the weights with::
 
-    python -m explaindrive.language.intent_classifier                    # mpnet (default)
-    python -m explaindrive.language.intent_classifier --encoder minilm
+    python -m explaindrive.language.intent_classifier                    # MiniLM (default)
+    python -m explaindrive.language.intent_classifier --encoder mpnet
 """
 
 from __future__ import annotations
