@@ -4,9 +4,9 @@ Usage::
 
     python scripts/decision_tradeoffs.py [--encoder minilm|mpnet] [--runtime torch|onnx]
 
-Rebuilds the held-out probabilities the shipped model's settings were tuned on (each of
-the ten development splits predicted by a model fitted on the training requests and the
-other nine, with the shipped model's blend, n-gram and cue weights, from the embeddings
+Rebuilds the held-out probabilities the shipped model's settings were tuned on (each
+development split predicted by a model fitted on the training requests and the other
+development splits, with the shipped model's blend, n-gram and cue weights, from the embeddings
 of the builder's runtime by default), then prints, for
 each STOP threshold, the missed and false STOPs, and, for each none margin (at the shipped
 STOP threshold), the command requests left without a command, the off-topic requests
