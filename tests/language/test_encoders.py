@@ -12,6 +12,7 @@ from explaindrive.language import encoders
 from explaindrive.language.encoders import (
     assemble_split_zip,
     check_encoder,
+    check_installed,
     mpnet_model_dir,
     mpnet_part_files,
 )
@@ -93,12 +94,20 @@ def test_a_complete_cache_is_used_without_the_parts(
     assert mpnet_model_dir(tmp_path) == done
     monkeypatch.setenv("EXPLAINDRIVE_CACHE", str(tmp_path))
     assert mpnet_model_dir() == done
+    assert check_installed("mpnet") == "mpnet"  # extracted once: the parts are not needed
 
 
-def test_missing_part_package_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_missing_part_package_names_the_extra(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     def missing(name: str) -> metadata.Distribution:
         raise metadata.PackageNotFoundError(name)
 
     monkeypatch.setattr(encoders.metadata, "distribution", missing)
-    with pytest.raises(FileNotFoundError, match=r"part-001.*reinstall with"):
+    extra = r"part-001.*pip install -e '\.\[mpnet\]'"
+    with pytest.raises(FileNotFoundError, match=extra):
         mpnet_part_files()
+    monkeypatch.setenv("EXPLAINDRIVE_CACHE", str(tmp_path))  # nothing extracted there
+    with pytest.raises(FileNotFoundError, match=extra):
+        check_installed("mpnet")
+    assert check_installed("minilm") == "minilm"  # a required dependency

@@ -9,6 +9,7 @@ from typing import Any, NoReturn
 import typer
 from rich.console import Console
 
+from explaindrive.cli._errors import error_line
 from explaindrive.language.config import LanguageConfig
 
 console = Console()
@@ -31,7 +32,7 @@ def load_config(path: Path | None, encoder: str | None = None) -> LanguageConfig
 
 def fail(message: str, code: int = 2) -> NoReturn:
     """Print an error on stderr and exit."""
-    err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    err_console.print(error_line(message), highlight=False, soft_wrap=True)
     raise typer.Exit(code)
 
 

@@ -6,6 +6,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from explaindrive.cli._errors import error_line
 from explaindrive.commands import Command
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.metrics import EpisodeMetrics
@@ -24,7 +25,7 @@ def demo(
         cmd = Command.parse(command)
         env = UrbanDriveEnv(EnvConfig(traffic_level=traffic))
     except (ValueError, FileNotFoundError) as exc:
-        console.print(f"[red]error:[/red] {exc}")
+        console.print(error_line(exc))
         raise typer.Exit(2) from exc
     driver = CautiousDriver()
     metrics = EpisodeMetrics()

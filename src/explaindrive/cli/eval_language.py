@@ -50,7 +50,7 @@ def intents_command(
         from explaindrive.language.stack import make_language_stack
 
         cfg = load_config(config, encoder)
-        stack = make_language_stack(backend, cfg)
+        stack = make_language_stack(backend, cfg).load()
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_intents

@@ -9,6 +9,7 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from explaindrive.cli._errors import error_line
 from explaindrive.cli._grid_options import (
     ComfortPolicyOption,
     FastPolicyOption,
@@ -96,10 +97,10 @@ def evaluate_command(
             stop_schedule=stop_schedule, commands=commands, max_steps=max_steps,
         )  # fmt: skip
     except SpecError as exc:
-        err_console.print(f"[red]error:[/red] {exc}")
+        err_console.print(error_line(exc))
         raise typer.Exit(2) from None
     if (problem := check_ray_target(ray, ray_address)) is not None:
-        err_console.print(f"[red]error:[/red] {problem}")
+        err_console.print(error_line(problem))
         raise typer.Exit(2)
 
     n = len(plan.episodes)
@@ -112,7 +113,7 @@ def evaluate_command(
                 progress=lambda done, _total: bar.update(task, completed=done),
             )  # fmt: skip
     except (CheckpointError, RuntimeError) as exc:
-        err_console.print(f"[red]error:[/red] {exc}")
+        err_console.print(error_line(exc))
         raise typer.Exit(1) from None
 
     summary = summarize(plan.name, [(r.spec.traffic_level, r.result) for r in records])

@@ -33,8 +33,8 @@ def interpret_command(
     try:
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config, encoder))
-    except ValueError as exc:
+        stack = make_language_stack(backend, load_config(config, encoder)).load()
+    except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     transcript = None
     if audio is not None:

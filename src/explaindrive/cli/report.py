@@ -9,6 +9,7 @@ from typing import Annotated
 
 import typer
 
+from explaindrive.cli._errors import error_line
 from explaindrive.cli._grid_options import (
     ComfortPolicyOption,
     FastPolicyOption,
@@ -67,7 +68,7 @@ def report_command(
     from explaindrive.evaluation.spec import SpecError, parse_levels
 
     if (problem := check_ray_target(ray, ray_address)) is not None:
-        err_console.print(f"[red]error:[/red] {problem}")
+        err_console.print(error_line(problem))
         raise typer.Exit(2)
     try:
         names = parse_policy_list(policies)
@@ -77,7 +78,7 @@ def report_command(
             shield=shield,
         )  # fmt: skip
     except SpecError as exc:
-        err_console.print(f"[red]error:[/red] {exc}")
+        err_console.print(error_line(exc))
         raise typer.Exit(2) from None
     n = sum(len(run.episodes) for run in plan.runs)
     err_console.print(f"report: {len(plan.runs)} runs, {n} episodes")
@@ -96,7 +97,7 @@ def report_command(
                 progress=lambda done, _total: bar.update(task, completed=done),
             )  # fmt: skip
     except (CheckpointError, RuntimeError) as exc:
-        err_console.print(f"[red]error:[/red] {exc}")
+        err_console.print(error_line(exc))
         raise typer.Exit(1) from None
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(result.markdown, encoding="utf-8")

@@ -12,6 +12,7 @@ import typer
 from rich.console import Console
 from rich.live import Live
 
+from explaindrive.cli._errors import error_line
 from explaindrive.cli._language_common import ENCODER_HELP
 from explaindrive.language.encoders import DEFAULT_ENCODER
 from explaindrive.ride.config import RideConfig
@@ -78,17 +79,21 @@ def ride(
         controller = MergedController.from_package()
         language_config = LanguageConfig().with_encoder(encoder)
     except (ValueError, ScriptError, CheckpointError) as exc:
-        console.print(f"[red]error:[/red] {exc}")
+        console.print(error_line(exc))
         raise typer.Exit(2) from exc
     if voice and not interactive:
-        console.print("[red]error:[/red] --voice needs --interactive")
+        console.print(error_line("--voice needs --interactive"))
         raise typer.Exit(2)
     typed: queue.Queue[str] | None = None
     if interactive:
         typed = queue.Queue()
         _start_input_thread(typed, voice)
     speech = voice or any(ln.audio for ln in lines)
-    language = make_language_stack(backend, language_config).load(speech=speech)
+    try:
+        language = make_language_stack(backend, language_config).load(speech=speech)
+    except (FileNotFoundError, ValueError) as exc:
+        console.print(error_line(exc))
+        raise typer.Exit(2) from exc
     session = RideSession(config, controller, language)
     if script is None and not interactive:
         console.print(f"default ride script: {default_script_path()}")

@@ -7,6 +7,7 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
+from explaindrive.cli._errors import error_line
 from explaindrive.sim.scenario.files import package_data_dir
 
 scenario_app = typer.Typer(help="Build or draw the urban SUMO scenario.", no_args_is_help=True)
@@ -33,7 +34,7 @@ def plot(
 
     net_file = net or package_data_dir() / "urban.net.xml"
     if not net_file.is_file():
-        Console().print(f"[red]error:[/red] network file not found: {net_file}")
+        Console().print(error_line(f"network file not found: {net_file}"))
         raise typer.Exit(2)
     Console().print(f"figure written to {plot_network(net_file, out)}")
 

