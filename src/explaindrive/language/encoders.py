@@ -100,7 +100,7 @@ def check_installed(name: str) -> str:
     """
     if check_encoder(name) == "minilm":
         minilm_model_dir()
-    elif not is_complete(cache_dir() / "models" / MPNET_NAME):
+    elif not is_complete(mpnet_cache_dir()):
         mpnet_part_files()
     return name
 
@@ -139,6 +139,12 @@ def mpnet_part_files() -> list[Path]:
     return parts
 
 
+def mpnet_cache_dir(root: Path | None = None) -> Path:
+    """Where all-mpnet-base-v2 is extracted: ``<root>/models/all-mpnet-base-v2``, ``root``
+    defaulting to :func:`explaindrive.cache.cache_dir`."""
+    return (root or cache_dir()) / "models" / MPNET_NAME
+
+
 def mpnet_model_dir(root: Path | None = None) -> Path:
     """all-mpnet-base-v2, joined from its five packages into ``root`` on first use.
 
@@ -149,7 +155,7 @@ def mpnet_model_dir(root: Path | None = None) -> Path:
         FileNotFoundError: if a part package is missing.
         ValueError: if the joined parts are not the expected model archive.
     """
-    target = (root or cache_dir()) / "models" / MPNET_NAME
+    target = mpnet_cache_dir(root)
     if is_complete(target):
         return target
     return assemble_split_zip(mpnet_part_files(), target, MPNET_NAME)
