@@ -11,7 +11,9 @@ from explaindrive.agent.buffer import ReplayBuffer, replay_nbytes
 def _add(buf: ReplayBuffer, start: int, n: int) -> None:
     ids = np.arange(start, start + n, dtype=np.float32)
     obs = np.repeat(ids[:, None], 8, axis=1)
-    buf.add(obs, ids.astype(np.int64) % 7, ids, obs + 0.5, ids % 2 == 0)
+    mask = np.zeros((n, 7), dtype=bool)
+    mask[np.arange(n), ids.astype(np.int64) % 7] = True
+    buf.add(obs, ids.astype(np.int64) % 7, ids, obs + 0.5, ids % 2 == 0, 0.99**3, mask, ~mask)
 
 
 def test_ring_overwrites_the_oldest() -> None:
@@ -24,6 +26,9 @@ def test_ring_overwrites_the_oldest() -> None:
     assert buf.next_obs[:, 0].tolist() == [4.5, 5.5, 2.5, 3.5]
     assert buf.rewards.tolist() == [4.0, 5.0, 2.0, 3.0]
     assert buf.terminated.tolist() == [True, False, True, False]
+    assert buf.discount.tolist() == pytest.approx([0.970299] * 4)
+    assert buf.mask.argmax(axis=1).tolist() == [4, 5, 2, 3]  # the action's slot, as added
+    assert (buf.next_mask.sum(axis=1) == 6).all()
     with pytest.raises(ValueError, match="cannot add 5"):
         _add(buf, 0, 5)
 
@@ -36,15 +41,24 @@ def test_sample_returns_consistent_rows() -> None:
     assert set(batch.rewards.tolist()) <= {0.0, 1.0, 2.0, 3.0, 4.0, 5.0}
     assert np.array_equal(batch.obs[:, 0], batch.rewards)
     assert np.array_equal(batch.next_obs[:, 0], batch.rewards + 0.5)
+    assert np.array_equal(batch.mask.argmax(axis=1), batch.actions)
+    assert not (batch.mask & batch.next_mask).any()
     with pytest.raises(ValueError, match="empty"):
         ReplayBuffer(3).sample(1, np.random.default_rng(0))
 
 
 def test_paper_capacity_fits_well_under_one_gigabyte() -> None:
-    # 5M x (2 x 8 x 4 B states + 1 B action + 4 B reward + 1 B flag) = 350 MB
-    assert replay_nbytes(5_000_000) == 350_000_000
+    # 5M x (2 x 8 x 4 B states + 1 B action + 4 B reward + 4 B discount + 1 B flag
+    # + 2 x 7 B masks) = 5M x 88 B = 440 MB
+    assert replay_nbytes(5_000_000) == 440_000_000
     buf = ReplayBuffer(5_000_000)  # np.zeros: pages are only committed when written
-    assert buf.nbytes == 350_000_000 < 1 << 30
+    assert buf.nbytes == 440_000_000 < 1 << 30
+
+
+def test_missing_masks_allow_every_action() -> None:
+    buf = ReplayBuffer(2)
+    buf.add(np.zeros((1, 8)), np.array([3]), np.array([1.0]), np.zeros((1, 8)), np.array([0]), 0.9)
+    assert buf.mask[0].all() and buf.next_mask[0].all() and buf.discount[0] == pytest.approx(0.9)
 
 
 def test_state_dict_round_trip() -> None:
@@ -55,5 +69,9 @@ def test_state_dict_round_trip() -> None:
     other.load_state_dict(buf.state_dict())
     assert (len(other), other.pos) == (4, 2)
     assert np.array_equal(other.obs, buf.obs) and np.array_equal(other.actions, buf.actions)
+    assert np.array_equal(other.mask, buf.mask) and np.array_equal(other.discount, buf.discount)
+    old = {k: v for k, v in buf.state_dict().items() if k != "next_mask"}
+    with pytest.raises(ValueError, match="lacks next_mask"):
+        ReplayBuffer(4).load_state_dict(old)
     with pytest.raises(ValueError, match="capacity 4"):
         ReplayBuffer(8).load_state_dict(buf.state_dict())

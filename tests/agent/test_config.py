@@ -30,10 +30,12 @@ def test_paper_preset_holds_the_paper_values() -> None:
     assert c.episodes == 11_000
 
 
-def test_fast_preset_is_shorter_and_valid() -> None:
-    c = preset("fast")
+def test_safe_preset_is_shorter_and_learns_the_shield() -> None:
+    c = preset("safe")
     assert c.episodes < PAPER.episodes
     assert c.eps_decay_steps < PAPER.eps_decay_steps
+    assert c.safe_learning and c.n_step == 3 and c.stop_when_safe == 200
+    assert not PAPER.safe_learning and PAPER.n_step == 1 and PAPER.stop_when_safe is None
 
 
 def test_unknown_preset_and_key_are_rejected() -> None:
@@ -82,13 +84,13 @@ def test_config_file_then_overrides(tmp_path: Path) -> None:
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"batchsize": 32}))
     with pytest.raises(ConfigError, match="batchsize"):
-        build_config("fast", bad)
+        build_config("safe", bad)
     with pytest.raises(ConfigError, match="cannot read config file"):
-        build_config("fast", tmp_path / "missing.yaml")
+        build_config("safe", tmp_path / "missing.yaml")
 
 
 def test_json_round_trip() -> None:
-    c = preset("fast").replace(num_envs=3, lr_final=None)
+    c = preset("safe").replace(num_envs=3, lr_final=None)
     assert TrainConfig.from_dict(json.loads(c.to_json())) == c
     assert c.envs == 3
 
@@ -96,6 +98,6 @@ def test_json_round_trip() -> None:
 def test_exponent_without_dot_is_a_number(tmp_path: Path) -> None:
     f = tmp_path / "c.yaml"
     f.write_text("lr: 3e-4\n")  # YAML 1.1 reads this as a string
-    assert build_config("fast", f).lr == pytest.approx(3e-4)
+    assert build_config("safe", f).lr == pytest.approx(3e-4)
     with pytest.raises(ConfigError, match="'lr' must be a number"):
-        build_config("fast", overrides={"lr": "nan"})
+        build_config("safe", overrides={"lr": "nan"})

@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 import torch
 
-from explaindrive.agent.buffer import ReplayBuffer
+from explaindrive.agent.buffer import ReplayBatch, ReplayBuffer
 from explaindrive.agent.config import PAPER
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
+from explaindrive.agent.shield import training_mask
 from explaindrive.agent.targets import dueling_aggregate
 from explaindrive.env.state import normalize
 
@@ -52,21 +53,48 @@ def test_epsilon_greedy_batch() -> None:
     assert set(random.tolist()) == set(range(7))
 
 
-def test_shielded_actions_stay_safe() -> None:
-    learner = D3QNLearner(PAPER.replace(hidden_sizes=[4], shield=True))
+def test_masked_exploration_keeps_allowed_actions() -> None:
+    learner = D3QNLearner(PAPER.replace(hidden_sizes=[4]))
     with torch.no_grad():
         for p in learner.q.parameters():
             p.zero_()
         learner.q.advantage.bias.copy_(torch.arange(7.0))  # greedy: +3 m/s
     # 10 m/s towards a red light 30 m ahead: +2 and +3 cannot stop in time; +1 can
-    # (11 + 8 + 5 + 2 + 2 = 28 <= 30), so the shield keeps the best safe action, +1.
+    # (11 + 8 + 5 + 2 + 2 = 28 <= 30), so the mask keeps the best allowed action, +1.
     red = np.tile(np.array([0, 10.0, 13.89, 30.0, 10.0, 30.0, 2, 200.0], np.float32), (300, 1))
+    mask = training_mask(red)
     rng = np.random.default_rng(0)
-    assert set(learner.act(red, 0.0, rng).tolist()) == {4}
-    explored = learner.act(red, 1.0, rng)  # random actions, unsafe ones replaced
+    assert set(learner.act(red, 0.0, rng, mask).tolist()) == {4}
+    explored = learner.act(red, 1.0, rng, mask)  # random actions, forbidden ones replaced
     assert set(explored.tolist()) == {0, 1, 2, 3, 4}
-    free = np.array([[0, 5.0, 13.89, 200.0, 0.0, 200.0, 0, 200.0]], np.float32)
-    assert learner.act(free, 0.0, rng).tolist() == [6]
+    assert set(learner.act(red, 0.0, rng).tolist()) == {6}  # no mask: the bare choice
+
+
+def test_safe_learning_pushes_unsafe_actions_down_and_masks_the_target() -> None:
+    cfg = PAPER.replace(hidden_sizes=[16], lr=1e-2, safe_learning=True, unsafe_q=-5.0,
+                        target_update_interval=1, batch_size=32)  # fmt: skip
+    learner = D3QNLearner(cfg)
+    obs = np.tile(np.array([0, 10.0, 13.89, 30.0, 10.0, 30.0, 2, 200.0], np.float32), (32, 1))
+    mask = training_mask(obs)  # +2, +3 unsafe
+    batch = ReplayBatch(
+        obs=obs, actions=np.full(32, 3), rewards=np.ones(32, np.float32), next_obs=obs,
+        terminated=np.ones(32, bool), discount=np.full(32, 0.99, np.float32), mask=mask,
+        next_mask=mask,
+    )  # fmt: skip
+    for _ in range(300):
+        stats = learner.update(batch, 0)
+    q = learner.q_values(obs[:1])[0]
+    assert q[5] < -4.5 and q[6] < -4.5  # pushed down to the floor (or below: one-sided)
+    assert q[3] == pytest.approx(1.0, abs=0.1)  # the taken action's terminal reward
+    assert stats["unsafe_loss"] < 0.1
+
+
+def test_epsilon_drops_to_its_final_value() -> None:
+    learner = D3QNLearner(PAPER.replace(eps_start=1.0, eps_end=0.05, eps_decay_steps=100,
+                                        eps_final=0.01, eps_final_after=200))  # fmt: skip
+    assert [learner.epsilon(t) for t in (0, 100, 199, 200)] == pytest.approx(
+        [1.0, 0.05, 0.05, 0.01]
+    )
 
 
 def test_learning_rate_schedule() -> None:
@@ -83,7 +111,7 @@ def test_learner_learns_a_contextual_bandit() -> None:
     buf = ReplayBuffer(2000)
     obs = rng.uniform(0, 1, (2000, 8)).astype(np.float32) * np.float32(20)
     actions = rng.integers(0, 7, 2000)
-    buf.add(obs, actions, (actions == 6).astype(np.float32), obs, np.ones(2000, bool))
+    buf.add(obs, actions, (actions == 6).astype(np.float32), obs, np.ones(2000, bool), 0.99)
     losses = [learner.update(buf.sample(64, rng), 0)["td_loss"] for _ in range(300)]
     assert np.mean(losses[-20:]) < 0.1 * np.mean(losses[:20])
     assert (learner.act(obs[:100], 0.0, rng) == 6).all()

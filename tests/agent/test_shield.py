@@ -3,12 +3,21 @@
 import numpy as np
 import pytest
 
-from explaindrive.agent.shield import braking_distance, is_safe, shield, stop_in_time
+from explaindrive.agent.shield import (
+    braking_distance,
+    braking_distances,
+    is_safe,
+    runtime_mask,
+    safe_action_mask,
+    shield,
+    stop_in_time,
+    training_mask,
+)
 from explaindrive.env.actions import action_index
 
 
-def obs(v=10.0, lim=13.89, d_lead=200.0, dv=0.0, d_tl=200.0, tls=0, d_cross=200.0):
-    return np.array([0, v, lim, d_lead, dv, d_tl, tls, d_cross], dtype=np.float32)
+def obs(v=10.0, lim=13.89, d_lead=200.0, dv=0.0, d_tl=200.0, tls=0, d_cross=200.0, cmd=0):
+    return np.array([cmd, v, lim, d_lead, dv, d_tl, tls, d_cross], dtype=np.float32)
 
 
 @pytest.mark.parametrize(
@@ -73,3 +82,48 @@ def test_stop_in_time():
     # with 1 step left only a standstill in this step will do
     assert not stop_in_time(3.0, action_index(-1), 1)
     assert stop_in_time(3.0, action_index(-3), 1)
+
+
+def test_braking_distances_of_a_batch_match_the_step_sum() -> None:
+    speeds = np.array([13.0, 6.0, 3.0, 0.0, 9.5, 1.0])
+    # 10+7+4+1, 3, 0, 0, 6.5+3.5+0.5, 0
+    assert braking_distances(speeds).tolist() == pytest.approx([22, 3, 0, 0, 10.5, 0])
+
+
+def test_mask_of_a_batch_is_the_mask_of_each_row() -> None:
+    rows = np.stack([obs(v=10, d_lead=30, dv=10, d_tl=30, tls=2), obs(v=12), obs(v=17)])
+    mask = safe_action_mask(rows)
+    assert mask.shape == (3, 7)
+    for row, expected in zip(rows, mask, strict=True):
+        assert np.array_equal(safe_action_mask(row), expected)
+    assert mask[0].tolist() == [True] * 5 + [False] * 2  # +2/+3 cannot stop for the red light
+    assert mask[1].tolist() == [True] * 5 + [False] * 2  # 14 and 15 m/s > 13.89
+    assert mask[2].tolist() == [True] + [False] * 6  # above the limit: hardest braking only
+
+
+def test_training_mask_allows_dilemma_braking_and_runtime_mask_does_not() -> None:
+    yellow = obs(v=13, d_lead=10, dv=13, d_tl=10, tls=1)
+    assert training_mask(yellow)[:3].all()  # -3, -2, -1 allowed in training
+    assert not runtime_mask(yellow)[:3].any()  # the shield would override them
+    assert training_mask(yellow)[3] and runtime_mask(yellow)[3]  # going on is fine in both
+
+
+def test_stop_must_bring_the_standstill_closer() -> None:
+    # STOP at 10 m/s: ceil(10/3) = 4 steps; v_new must need at most 3: <= 9 m/s
+    stopping = obs(v=10, cmd=2)
+    assert training_mask(stopping).tolist() == [True, True, True, False, False, False, False]
+    # at 9 m/s: 3 steps; only 6 m/s (-3) needs 2
+    assert training_mask(obs(v=9, cmd=2)).tolist() == [True] + [False] * 6
+    # standing: only staying at 0 (the braking actions keep 0 m/s)
+    assert training_mask(obs(v=0, cmd=2)).tolist() == [True] * 4 + [False] * 3
+    assert training_mask(obs(v=10, cmd=0))[3:6].all()  # no such rule under FAST
+    # STOP in the dilemma zone of a yellow light: keep the speed and clear the junction
+    yellow = obs(v=13, d_lead=10, dv=13, d_tl=10, tls=1, cmd=2)
+    assert runtime_mask(yellow).tolist() == [False] * 3 + [True] + [False] * 3
+
+
+def test_where_nothing_is_safe_the_hardest_braking_is_allowed() -> None:
+    wall = obs(v=13, d_lead=1, dv=13, d_cross=1)
+    assert not safe_action_mask(wall).any()
+    assert training_mask(wall).tolist() == [True] + [False] * 6
+    assert runtime_mask(wall).tolist() == [True] + [False] * 6

@@ -10,6 +10,7 @@ from explaindrive.agent.targets import (
     dueling_aggregate,
     linear_schedule,
     td_loss,
+    unsafe_action_loss,
 )
 
 
@@ -32,6 +33,30 @@ def test_double_dqn_target_selects_online_and_evaluates_target() -> None:
     assert torch.allclose(target, torch.tensor([1.0 + 0.9 * 20.0, 0.5, -1.0 + 0.9 * 6.0]))
     # the plain DQN max over the target net would give 1 + 0.9 * 30 for the first one
     assert target[0].item() != pytest.approx(28.0)
+
+
+def test_masked_double_dqn_target_chooses_among_safe_actions() -> None:
+    next_online = torch.tensor([[1.0, 3.0, 2.0], [5.0, 0.0, 0.0]])
+    next_target = torch.tensor([[10.0, 20.0, 30.0], [7.0, 8.0, 9.0]])
+    mask = torch.tensor([[True, False, True], [False, True, True]])
+    gamma = torch.tensor([0.5, 0.25])  # per transition, e.g. gamma^n of n-step returns
+    target = double_dqn_target(
+        torch.zeros(2), torch.zeros(2), next_online, next_target, gamma, mask
+    )
+    # safe argmax online = (2, 1) (the unmasked ones would be 1 and 0) -> target Q (30, 8)
+    assert torch.allclose(target, torch.tensor([0.5 * 30.0, 0.25 * 8.0]))
+
+
+def test_unsafe_action_loss_pushes_only_unsafe_values_above_the_floor() -> None:
+    q = torch.tensor([[5.0, -20.0, 0.0], [1.0, 2.0, 3.0]])
+    mask = torch.tensor([[False, False, True], [True, True, False]])
+    # row 0: (5 - -10)^2 = 225, -20 is below the floor: 0; row 1: (3 + 10)^2 = 169
+    assert unsafe_action_loss(q, mask, -10.0, "mse").item() == pytest.approx((225 + 169) / 2)
+    # huber, delta 1: 15 - 0.5 and 13 - 0.5
+    assert unsafe_action_loss(q, mask, -10.0, "huber").item() == pytest.approx((14.5 + 12.5) / 2)
+    assert unsafe_action_loss(q, torch.ones(2, 3, dtype=torch.bool), -10.0).item() == 0.0
+    with pytest.raises(ValueError, match="unknown loss"):
+        unsafe_action_loss(q, mask, 0.0, "l1")
 
 
 def test_double_dqn_target_has_no_gradient() -> None:

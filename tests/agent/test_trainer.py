@@ -13,13 +13,14 @@ import textwrap
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from explaindrive.agent.checkpoint import CheckpointError, load_checkpoint
 from explaindrive.agent.config import SEED_POOL_BASE, TrainConfig, preset
 from explaindrive.agent.controller import QPolicy
 from explaindrive.agent.schedule import plan_episode
-from explaindrive.agent.trainer import moving_average, train
+from explaindrive.agent.trainer import NStepQueue, moving_average, train
 from tests.agent.fake_drive_env import FakeDriveEnv
 
 EPISODE_STEPS = 20
@@ -28,12 +29,12 @@ TINY = dict(
     num_envs=1, hidden_sizes=[32, 32], buffer_size=5_000, batch_size=16, learning_starts=50,
     train_frequency=2, target_update_interval=10, eps_decay_steps=150, checkpoint_every_episodes=4,
     log_every_updates=10, stop_gap_s=[3, 5], stop_duration_s=[2, 3], schedule_horizon_s=20.0,
-    moving_average_window=3,
+    moving_average_window=3, stop_when_safe=None,
 )  # fmt: skip
 
 
 def tiny(**changes: object) -> TrainConfig:
-    return preset("fast").replace(**{**TINY, **changes})
+    return preset("safe").replace(**{**TINY, **changes})
 
 
 def rows(out: Path) -> list[dict[str, str]]:
@@ -162,3 +163,51 @@ def test_killed_run_resumes_from_its_last_checkpoint(tmp_path: Path) -> None:
 def test_moving_average_by_hand() -> None:
     assert moving_average([1, 2, 3, 4, 5], 2).tolist() == [1.0, 1.5, 2.5, 3.5, 4.5]
     assert moving_average([1, 2, 3, 4, 5], 3).tolist() == [1.0, 1.5, 2.0, 3.0, 4.0]
+
+
+def test_n_step_queue_by_hand() -> None:
+    q = NStepQueue(3, 0.5)
+    obs = [np.full(8, float(i), np.float32) for i in range(6)]
+    mask = np.ones(7, bool)
+
+    def push(i: int, reward: float, terminated: bool = False, done: bool = False) -> list:
+        return q.push(obs[i], i, reward, mask, obs[i + 1], mask, terminated, done)
+
+    assert push(0, 1.0) == [] and push(1, 2.0) == []
+    (t0,) = push(2, 4.0)  # 1 + 0.5 * 2 + 0.25 * 4 = 3, bootstrapped from obs[3] with 0.5^3
+    assert (t0[0][0], t0[1], t0[2], t0[3][0], t0[4], t0[5]) == (0.0, 0, 3.0, 3.0, False, 0.125)
+    tail = push(3, 8.0, terminated=True, done=True)
+    # at the end every queued step leaves: 2 + 2 + 2 = 6 (0.5^3), 4 + 4 = 8 (0.5^2), 8 (0.5)
+    assert [(t[1], t[2], t[4], t[5]) for t in tail] == [
+        (1, 6.0, True, 0.125), (2, 8.0, True, 0.25), (3, 8.0, True, 0.5),
+    ]  # fmt: skip
+    assert [t[3][0] for t in tail] == [4.0, 4.0, 4.0]
+    (cut,) = push(4, 1.0, terminated=False, done=True)  # truncated: bootstraps, not terminal
+    assert (cut[2], cut[4], cut[5]) == (1.0, False, 0.5)
+
+
+class NearTheLimit(FakeDriveEnv):
+    """Starts every episode at 9 m/s, 1 m/s under the limit."""
+
+    def reset(self, *, seed=None, options=None):  # type: ignore[no-untyped-def]
+        super().reset(seed=seed, options=options)
+        self.v = 9.0
+        return self._obs(), {}
+
+
+def test_safe_learning_ends_the_run_once_episodes_run_clean(tmp_path: Path) -> None:
+    # the fake road's limit is 10 m/s: a greedy choice above it is one the shield overrides;
+    # acting on the bare network (no shielded episodes) at random first, early episodes speed
+    config = tiny(episodes=300, stop_when_safe=5, shielded_fraction=0.0, eps_end=0.0,
+                  eps_decay_steps=600)  # fmt: skip
+    result = train(config, tmp_path, env_factory=functools.partial(NearTheLimit, max_steps=40))
+    assert result.stopped_early and result.episodes < 300
+    table = rows(tmp_path)
+    assert len(table) == result.episodes
+
+    def clean(r: dict[str, str]) -> bool:
+        return float(r["shield_share"]) == 0.0 and r["speeding_steps"] == "0"
+
+    assert len(table) > 5 and all(clean(r) for r in table[-5:]) and not clean(table[-6])
+    assert all(r["shielded"] == "0" for r in table)
+    assert QPolicy.load(result.policy_path).card["stopped_early"] is True

@@ -1,8 +1,17 @@
 """Preallocated numpy ring buffer of transitions.
 
+A transition may span n steps (n-step returns): ``reward`` is then the discounted sum of
+the n rewards, ``next_obs`` the state n steps later and ``discount`` gamma^n (0 is never
+stored: a terminal transition keeps its ``terminated`` flag). ``mask`` marks the actions of
+``obs`` that learning does not penalise (:func:`explaindrive.agent.shield.training_mask`),
+``next_mask`` the actions of ``next_obs`` the double-DQN target may choose (those the shield
+keeps, :func:`explaindrive.agent.shield.runtime_mask`); both serve learning only and are
+never given to the network.
+
 Memory per transition: ``obs`` and ``next_obs`` as float32 (2 x 8 x 4 = 64 B), the action as
-int8 (1 B), the reward as float32 (4 B) and the termination flag as bool (1 B): 70 B. The
-paper's 5M transitions therefore take 350 MB (:func:`replay_nbytes`). ``next_obs`` is kept in
+int8 (1 B), the reward and the discount as float32 (8 B), the termination flag as bool
+(1 B) and the two masks as 7 bools each (14 B): 88 B. The paper's 5M transitions therefore
+take 440 MB (:func:`replay_nbytes`). ``next_obs`` is kept in
 its own array rather than recovered from the next slot because transitions of several
 parallel envs are interleaved and an episode's last ``next_obs`` is never a stored ``obs``.
 The arrays are allocated with ``np.zeros`` so untouched pages cost no resident memory.
@@ -15,14 +24,13 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from explaindrive.env.actions import N_ACTIONS
 from explaindrive.env.state import STATE_DIM
-
-BYTES_PER_TRANSITION = 2 * STATE_DIM * 4 + 1 + 4 + 1
 
 
 def replay_nbytes(capacity: int, state_dim: int = STATE_DIM) -> int:
     """Bytes held by a :class:`ReplayBuffer` of ``capacity`` transitions."""
-    return capacity * (2 * state_dim * 4 + 1 + 4 + 1)
+    return capacity * (2 * state_dim * 4 + 1 + 4 + 4 + 1 + 2 * N_ACTIONS)
 
 
 class ReplayBatch(NamedTuple):
@@ -33,6 +41,12 @@ class ReplayBatch(NamedTuple):
     rewards: NDArray[np.float32]
     next_obs: NDArray[np.float32]
     terminated: NDArray[np.bool_]
+    discount: NDArray[np.float32]
+    mask: NDArray[np.bool_]
+    next_mask: NDArray[np.bool_]
+
+
+_FIELDS = ("obs", "next_obs", "actions", "rewards", "terminated", "discount", "mask", "next_mask")
 
 
 class ReplayBuffer:
@@ -48,6 +62,9 @@ class ReplayBuffer:
         self.actions = np.zeros(capacity, dtype=np.int8)
         self.rewards = np.zeros(capacity, dtype=np.float32)
         self.terminated = np.zeros(capacity, dtype=np.bool_)
+        self.discount = np.zeros(capacity, dtype=np.float32)
+        self.mask = np.zeros((capacity, N_ACTIONS), dtype=np.bool_)
+        self.next_mask = np.zeros((capacity, N_ACTIONS), dtype=np.bool_)
         self.pos = 0  # next slot to write
         self.size = 0
 
@@ -57,8 +74,7 @@ class ReplayBuffer:
     @property
     def nbytes(self) -> int:
         """Bytes of the preallocated arrays."""
-        arrays = (self.obs, self.next_obs, self.actions, self.rewards, self.terminated)
-        return sum(a.nbytes for a in arrays)
+        return sum(getattr(self, name).nbytes for name in _FIELDS)
 
     def add(
         self,
@@ -67,8 +83,14 @@ class ReplayBuffer:
         rewards: NDArray[np.floating],
         next_obs: NDArray[np.floating],
         terminated: NDArray[np.bool_],
+        discount: NDArray[np.floating] | float,
+        mask: NDArray[np.bool_] | None = None,
+        next_mask: NDArray[np.bool_] | None = None,
     ) -> None:
-        """Append a batch of ``n`` transitions (first axis), overwriting the oldest ones."""
+        """Append a batch of ``n`` transitions (first axis), overwriting the oldest ones.
+
+        ``discount`` is gamma^n of each transition; a missing mask allows every action.
+        """
         obs = np.asarray(obs, dtype=np.float32).reshape(-1, self.state_dim)
         n = obs.shape[0]
         if n > self.capacity:
@@ -79,6 +101,10 @@ class ReplayBuffer:
         self.actions[idx] = np.asarray(actions).reshape(n)
         self.rewards[idx] = np.asarray(rewards, dtype=np.float32).reshape(n)
         self.terminated[idx] = np.asarray(terminated, dtype=np.bool_).reshape(n)
+        self.discount[idx] = np.broadcast_to(np.asarray(discount, dtype=np.float32), (n,))
+        for name, value in (("mask", mask), ("next_mask", next_mask)):
+            target = getattr(self, name)
+            target[idx] = True if value is None else np.asarray(value).reshape(n, N_ACTIONS)
         self.pos = int((self.pos + n) % self.capacity)
         self.size = min(self.size + n, self.capacity)
 
@@ -97,17 +123,16 @@ class ReplayBuffer:
             rewards=self.rewards[idx],
             next_obs=self.next_obs[idx],
             terminated=self.terminated[idx],
+            discount=self.discount[idx],
+            mask=self.mask[idx],
+            next_mask=self.next_mask[idx],
         )
 
     def state_dict(self) -> dict[str, NDArray[np.generic]]:
         """The filled part of the buffer and its write position (for checkpoints)."""
         n = self.size
         return {
-            "obs": self.obs[:n],
-            "next_obs": self.next_obs[:n],
-            "actions": self.actions[:n],
-            "rewards": self.rewards[:n],
-            "terminated": self.terminated[:n],
+            **{name: getattr(self, name)[:n] for name in _FIELDS},
             "pos": np.array(self.pos, dtype=np.int64),
             "capacity": np.array(self.capacity, dtype=np.int64),
         }
@@ -125,10 +150,10 @@ class ReplayBuffer:
                 f"saved replay buffer (capacity {capacity}, state {state['obs'].shape[1:]}) does "
                 f"not match this one (capacity {self.capacity}, state ({self.state_dim},))"
             )
-        self.obs[:n] = state["obs"]
-        self.next_obs[:n] = state["next_obs"]
-        self.actions[:n] = state["actions"]
-        self.rewards[:n] = state["rewards"]
-        self.terminated[:n] = state["terminated"]
+        missing = [name for name in _FIELDS if name not in state]
+        if missing:
+            raise ValueError(f"saved replay buffer lacks {', '.join(missing)}")
+        for name in _FIELDS:
+            getattr(self, name)[:n] = state[name]
         self.size = n
         self.pos = int(state["pos"])

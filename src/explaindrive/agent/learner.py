@@ -11,8 +11,12 @@ import torch
 from explaindrive.agent.buffer import ReplayBatch
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.network import DuelingQNetwork
-from explaindrive.agent.shield import is_safe, shield
-from explaindrive.agent.targets import double_dqn_target, linear_schedule, td_loss
+from explaindrive.agent.targets import (
+    double_dqn_target,
+    linear_schedule,
+    td_loss,
+    unsafe_action_loss,
+)
 from explaindrive.env.actions import N_ACTIONS
 
 
@@ -34,8 +38,11 @@ class D3QNLearner:
         self.updates = 0
 
     def epsilon(self, env_steps: int) -> float:
-        """Exploration rate after ``env_steps`` transitions (linear decay)."""
+        """Exploration rate after ``env_steps`` transitions: linear decay to ``eps_end``, then
+        ``eps_final`` from ``eps_final_after`` on (if set)."""
         c = self.config
+        if c.eps_final is not None and env_steps >= c.eps_final_after:
+            return c.eps_final
         return linear_schedule(c.eps_start, c.eps_end, c.eps_decay_steps, env_steps)
 
     def learning_rate(self, env_steps: int) -> float:
@@ -46,26 +53,50 @@ class D3QNLearner:
         return linear_schedule(c.lr, c.lr_final, c.lr_decay_steps, env_steps)
 
     @torch.no_grad()
-    def act(self, obs: np.ndarray, epsilon: float, rng: np.random.Generator) -> np.ndarray:
-        """Epsilon-greedy actions for a batch of raw observations, in one forward pass."""
+    def q_values(self, obs: np.ndarray) -> np.ndarray:
+        """Online Q-values of a batch of raw observations, shape ``(B, n_actions)``."""
         obs = np.asarray(obs, dtype=np.float32).reshape(-1, self.q.state_dim)
-        q_values = self.q(torch.from_numpy(obs)).numpy()
+        return self.q(torch.from_numpy(obs)).numpy()
+
+    @staticmethod
+    def explore(
+        q_values: np.ndarray,
+        epsilon: float,
+        rng: np.random.Generator,
+        mask: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Epsilon-greedy actions from Q-values; with a ``mask`` (bool, one row per state),
+        a chosen action the mask forbids becomes the best-valued allowed one."""
         greedy = q_values.argmax(axis=-1)
-        explore = rng.random(len(obs)) < epsilon
-        random_actions = rng.integers(0, N_ACTIONS, size=len(obs))
+        explore = rng.random(len(q_values)) < epsilon
+        random_actions = rng.integers(0, N_ACTIONS, size=len(q_values))
         actions = np.where(explore, random_actions, greedy).astype(np.int64)
-        if self.config.shield:
-            for i, a in enumerate(actions):
-                if not is_safe(obs[i], int(a)):
-                    actions[i] = shield(obs[i], q_values[i]).action
+        if mask is not None:
+            allowed = mask[np.arange(len(actions)), actions]
+            best_safe = np.where(mask, q_values, -np.inf).argmax(axis=-1)
+            actions = np.where(allowed, actions, best_safe)
         return actions
+
+    def act(
+        self,
+        obs: np.ndarray,
+        epsilon: float,
+        rng: np.random.Generator,
+        mask: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Epsilon-greedy actions for a batch of raw observations, in one forward pass."""
+        return self.explore(self.q_values(obs), epsilon, rng, mask)
 
     def update(self, batch: ReplayBatch, env_steps: int) -> dict[str, float]:
         """One gradient step on a minibatch; updates the target network when due.
 
+        With ``safe_learning`` the double-DQN argmax runs over the safe actions of the next
+        state and the unsafe actions of the state are pushed down to ``unsafe_q``.
+
         Returns:
-            ``td_loss``, ``q_values`` (mean Q of the taken actions), ``learning_rate`` and
-            ``grad_norm`` (before clipping; 0 when clipping is off).
+            ``td_loss``, ``unsafe_loss`` (0 without ``safe_learning``), ``q_values`` (mean Q
+            of the taken actions), ``learning_rate`` and ``grad_norm`` (before clipping; 0
+            when clipping is off).
         """
         c = self.config
         lr = self.learning_rate(env_steps)
@@ -81,9 +112,18 @@ class D3QNLearner:
         q_obs, next_online = q_both[: len(obs)], q_both[len(obs) :].detach()
         with torch.no_grad():
             next_target = self.q_target(next_obs)
-        target = double_dqn_target(rewards, terminated, next_online, next_target, c.gamma)
+        discount = torch.from_numpy(batch.discount)
+        next_mask = torch.from_numpy(batch.next_mask) if c.safe_learning else None
+        target = double_dqn_target(
+            rewards, terminated, next_online, next_target, discount, next_mask
+        )
         q_taken = q_obs.gather(1, actions.unsqueeze(1)).squeeze(1)
-        loss = td_loss(q_taken, target, c.loss, c.huber_delta)
+        loss = td = td_loss(q_taken, target, c.loss, c.huber_delta)
+        unsafe = torch.zeros(())
+        if c.safe_learning:
+            mask = torch.from_numpy(batch.mask)
+            unsafe = unsafe_action_loss(q_obs, mask, c.unsafe_q, c.loss, c.huber_delta)
+            loss = td + c.unsafe_loss_weight * unsafe
 
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
@@ -95,7 +135,8 @@ class D3QNLearner:
         if self.updates % c.target_update_interval == 0:
             self.update_target(c.tau)
         return {
-            "td_loss": float(loss.detach()),
+            "td_loss": float(td.detach()),
+            "unsafe_loss": float(unsafe.detach()),
             "q_values": float(q_taken.detach().mean()),
             "learning_rate": lr,
             "grad_norm": grad_norm,

@@ -1,17 +1,23 @@
-"""A kinematic safety shield: keeps a policy's greedy choice unless it is unsafe.
+"""A kinematic safety shield: which actions keep a stopping option, and the best safe one.
 
-Among the actions ordered by Q-value, the shield takes the first one after
-which the ego could still stop behind its leader (real or virtual) braking at
--3 m/s per step, even if a real leader brakes at 9 m/s^2 (SUMO's emergency
-deceleration), and which does not exceed the posted limit. If no action
-qualifies, it brakes as hard as it can. Under STOP it also keeps the stop within
-its latency bound (ceil(v/3) + 2 steps from the command).
+An action is safe when, after it, the ego could still stop braking at -3 m/s per step:
 
-Red and yellow lights and occupied crossings are stop lines the ego must be able
-to stop before; a yellow light that even the hardest braking cannot stop for is
-not (the dilemma zone): there the ego goes on without slowing down, since
-braking would only leave it on the junction at red.
-The shield is off during training; it is a runtime guard in the controller.
+- behind its real leader, even if that leader brakes at 9 m/s^2 (SUMO's emergency
+  deceleration), with a 2 m margin;
+- before a red or yellow light and before an occupied crossing (the virtual leaders);
+- without exceeding the posted limit (above it, only the hardest braking is safe).
+
+A yellow light that even the hardest braking cannot stop for is the dilemma zone: the
+ego goes on without slowing down, since braking would only leave it on the junction at
+red. At run time (:func:`shield`) braking there is unsafe; the training mask
+(:func:`safe_action_mask` with ``dilemma_braking=True``) leaves it allowed, so that
+learning is not taught to forbid it. Under STOP the shield also keeps the stop within its
+latency bound (ceil(v/3) + 2 steps from the command); the training mask asks instead that
+every step under STOP brings the standstill one hardest-braking step closer, which keeps
+that bound without knowing when the command came.
+
+Every rule is written once, vectorised over a batch of raw observations
+(:func:`safe_action_mask`); the scalar helpers index it.
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from explaindrive.commands import Command
 from explaindrive.env import state as S
 from explaindrive.env.actions import SPEED_CHANGES_MPS, action_index
 
@@ -30,19 +37,112 @@ MAX_BRAKE_MPS = 3  # [m/s per step] the strongest action
 LEADER_BRAKE_MPS = 9.0  # [m/s per step] how hard a real leader may brake (SUMO emergency decel)
 MARGIN_M = 2.0  # [m] gap kept at standstill
 VIRTUAL_TOL_M = 0.5  # [m] a leader this close to a stop line is the virtual leader
+HARDEST_BRAKE = action_index(-MAX_BRAKE_MPS)
+_CHANGES = np.asarray(SPEED_CHANGES_MPS, dtype=np.float64)
+
+
+def braking_distances(
+    speed_mps: NDArray[np.floating], brake_mps: float = MAX_BRAKE_MPS
+) -> NDArray[np.float64]:
+    """Distances [m] covered after this step when braking by ``brake_mps`` per 1 s step.
+
+    SUMO moves a car by its new speed each step, so from ``v`` the car covers
+    (v - b) + (v - 2b) + ... (the positive terms) while braking to a standstill:
+    with n = ceil(v / b) - 1 terms that is n v - b n (n + 1) / 2.
+    """
+    v = np.maximum(np.asarray(speed_mps, dtype=np.float64), 0.0)
+    n = np.maximum(np.ceil(v / brake_mps) - 1.0, 0.0)
+    return n * v - brake_mps * n * (n + 1.0) / 2.0
 
 
 def braking_distance(speed_mps: float, brake_mps: float = MAX_BRAKE_MPS) -> float:
-    """Distance [m] covered after this step when braking by ``brake_mps`` per 1 s step.
+    """:func:`braking_distances` of one speed."""
+    return float(braking_distances(np.asarray(speed_mps), brake_mps))
 
-    SUMO moves a car by its new speed each step, so from ``v`` the car covers
-    (v - 3) + (v - 6) + ... while braking to a standstill.
+
+def _stopping_need(v_new: NDArray[np.float64]) -> NDArray[np.float64]:
+    """[m] from the ego's front to where it stands still after this step and braking."""
+    return v_new + braking_distances(v_new) + MARGIN_M
+
+
+def steps_to_stop(speed_mps: NDArray[np.floating] | float) -> NDArray[np.float64]:
+    """Steps of hardest braking from ``speed_mps`` to a standstill: ceil(v / 3)."""
+    v = np.maximum(np.asarray(speed_mps, dtype=np.float64), 0.0)
+    return np.ceil(v / MAX_BRAKE_MPS - 1e-6)
+
+
+def safe_action_mask(
+    obs: NDArray[np.floating], dilemma_braking: bool = False, stop_progress: bool = False
+) -> NDArray[np.bool_]:
+    """Which of the 7 actions are safe in each raw observation.
+
+    Args:
+        obs: raw observations, shape ``(B, 8)`` (or one of shape ``(8,)``).
+        dilemma_braking: allow slowing down in the yellow-light dilemma zone (training).
+        stop_progress: under STOP (``cmd = 2``), allow only actions after which the
+            hardest braking needs one step fewer to a standstill (and, at a standstill,
+            only staying there); in the dilemma zone keeping the speed is allowed too, to
+            clear the junction before stopping.
+
+    Returns:
+        Boolean mask of shape ``(B, 7)`` (``(7,)`` for one observation). A row may be all
+        false: then no action keeps a stopping option (see :func:`training_mask`).
     """
-    total, v = 0.0, speed_mps - brake_mps
-    while v > 0:
-        total += v
-        v -= brake_mps
-    return total
+    x = np.asarray(obs, dtype=np.float64)
+    single = x.ndim == 1
+    x = x.reshape(-1, S.STATE_DIM)
+    v = x[:, S.V_EGO : S.V_EGO + 1]  # (B, 1)
+    v_new = np.maximum(v + _CHANGES, 0.0)  # (B, 7)
+    need = _stopping_need(v_new)
+
+    over_limit = v_new > x[:, S.V_LIM : S.V_LIM + 1]
+    safe = ~(over_limit & (v_new > v - MAX_BRAKE_MPS + 1e-9))
+
+    d_cross = x[:, S.D_CROSS : S.D_CROSS + 1]
+    safe &= ~((d_cross < S.SENSOR_RANGE_M) & (need > d_cross))
+
+    d_tl = x[:, S.D_TL : S.D_TL + 1]
+    tls = np.rint(x[:, S.TLS : S.TLS + 1])
+    light = (d_tl < S.SENSOR_RANGE_M) & (tls != 0)
+    must_go = light & (tls == 1) & (_stopping_need(np.maximum(v - MAX_BRAKE_MPS, 0.0)) > d_tl)
+    safe &= ~(light & ~must_go & (need > d_tl))
+    if not dilemma_braking:
+        safe &= ~(must_go & (v_new < v))
+
+    gap = x[:, S.D_LEAD : S.D_LEAD + 1]
+    virtual = ((tls != 0) & (np.abs(gap - d_tl) <= VIRTUAL_TOL_M)) | (
+        np.abs(gap - d_cross) <= VIRTUAL_TOL_M
+    )
+    real = (gap < S.SENSOR_RANGE_M) & ~virtual
+    leader_v = np.maximum(v - x[:, S.DV : S.DV + 1], 0.0)
+    safe &= ~(real & (gap + braking_distances(leader_v, LEADER_BRAKE_MPS) < need))
+
+    if stop_progress:
+        stopping = np.rint(x[:, S.CMD : S.CMD + 1]) == int(Command.STOP)
+        closer = (steps_to_stop(v_new) < steps_to_stop(v)) | (v_new <= 0.0)
+        clearing = must_go & (v_new == v)  # in the dilemma zone: clear the junction first
+        safe &= ~(stopping & ~closer & ~clearing)
+    return safe[0] if single else safe
+
+
+def _with_fallback(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Rows that allow nothing allow the hardest braking (what the shield does there)."""
+    rows = mask.reshape(-1, len(SPEED_CHANGES_MPS))
+    rows[~rows.any(axis=1), HARDEST_BRAKE] = True
+    return mask
+
+
+def training_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
+    """The safety mask learning uses: dilemma braking allowed, STOP must make progress,
+    and the hardest braking where nothing is safe (every row allows an action)."""
+    return _with_fallback(safe_action_mask(obs, dilemma_braking=True, stop_progress=True))
+
+
+def runtime_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
+    """The actions the run-time shield keeps (dilemma braking forbidden), with STOP's
+    progress rule standing in for its latency bound: a greedy action outside this mask is
+    one the shield would override."""
+    return _with_fallback(safe_action_mask(obs, stop_progress=True))
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,54 +155,7 @@ class ShieldDecision:
 
 def is_safe(obs: NDArray[np.floating], action: int) -> bool:
     """Whether ``action`` keeps a stopping option and respects the posted limit."""
-    v = float(obs[S.V_EGO])
-    v_new = max(0.0, v + SPEED_CHANGES_MPS[action])
-    if v_new > float(obs[S.V_LIM]) and v_new > v - MAX_BRAKE_MPS + 1e-9:
-        return False
-    lines, must_go = _stop_lines(obs, v)
-    if must_go and v_new < v:
-        return False  # committed to a yellow it cannot stop for: clear it quickly
-    need = _stopping_need(v_new)
-    if any(need > line for line in lines):
-        return False
-    gap = float(obs[S.D_LEAD])
-    if gap >= S.SENSOR_RANGE_M or _is_stop_line(obs, gap):
-        return True
-    leader_v = max(0.0, v - float(obs[S.DV]))
-    return gap + braking_distance(leader_v, LEADER_BRAKE_MPS) >= need
-
-
-def _stopping_need(v_new: float) -> float:
-    """[m] from the ego's front to where it stands still after this step and braking."""
-    return v_new + braking_distance(v_new) + MARGIN_M
-
-
-def _stop_lines(obs: NDArray[np.floating], v: float) -> tuple[list[float], bool]:
-    """Stop lines the ego must not pass, and whether it is committed to go.
-
-    Red and yellow lights and occupied crossings are stop lines, except a yellow
-    light that even the hardest braking now cannot stop for (the dilemma zone):
-    then the ego must go on without slowing down.
-    """
-    lines = []
-    d_cross = float(obs[S.D_CROSS])
-    if d_cross < S.SENSOR_RANGE_M:
-        lines.append(d_cross)
-    tls = round(float(obs[S.TLS]))
-    d_tl = float(obs[S.D_TL])
-    must_go = False
-    if d_tl < S.SENSOR_RANGE_M and tls != 0:
-        hardest = max(0.0, v - MAX_BRAKE_MPS)
-        must_go = tls == 1 and _stopping_need(hardest) > d_tl
-        if not must_go:
-            lines.append(d_tl)
-    return lines, must_go
-
-
-def _is_stop_line(obs: NDArray[np.floating], gap: float) -> bool:
-    light = round(float(obs[S.TLS])) != 0 and abs(gap - float(obs[S.D_TL])) <= VIRTUAL_TOL_M
-    cross = abs(gap - float(obs[S.D_CROSS])) <= VIRTUAL_TOL_M
-    return light or cross
+    return bool(safe_action_mask(obs)[action])
 
 
 def stop_in_time(speed_mps: float, action: int, steps_left: int) -> bool:
@@ -126,11 +179,12 @@ def shield(
             would miss it are not allowed.
     """
     order = np.argsort(-np.asarray(q_values, dtype=np.float64), kind="stable")
+    mask = safe_action_mask(obs)
     v = float(obs[S.V_EGO])
     for rank, a in enumerate(order):
         late = (
             stop_steps_left is not None and v > 0 and not stop_in_time(v, int(a), stop_steps_left)
         )
-        if not late and is_safe(obs, int(a)):
+        if not late and mask[a]:
             return ShieldDecision(int(a), overridden=rank > 0)
-    return ShieldDecision(action_index(-MAX_BRAKE_MPS), overridden=True)
+    return ShieldDecision(HARDEST_BRAKE, overridden=True)

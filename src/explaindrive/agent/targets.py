@@ -31,29 +31,63 @@ def double_dqn_target(
     terminated: Tensor,
     next_q_online: Tensor,
     next_q_target: Tensor,
-    gamma: float,
+    gamma: float | Tensor,
+    next_mask: Tensor | None = None,
 ) -> Tensor:
     """Double-DQN bootstrap target ``r + gamma (1 - done) Q_target(s', argmax_a Q_online(s', a))``.
 
     The online network selects the next action and the target network evaluates it, which
     removes most of the over-estimation of the plain max. ``terminated`` must be true only
     for real terminal states (collision, leaving the route), not for time-limit truncation.
+    With ``next_mask`` the argmax runs over the allowed (safe) actions of ``s'`` only, so the
+    values of unsafe actions never leak into the targets of safe ones.
 
     Args:
-        rewards: shape ``(B,)``.
+        rewards: shape ``(B,)`` (for n-step transitions the discounted sum of n rewards).
         terminated: shape ``(B,)``, bool or 0/1.
         next_q_online: online Q-values of the next states, ``(B, n_actions)``.
         next_q_target: target-network Q-values of the next states, ``(B, n_actions)``.
-        gamma: discount factor.
+        gamma: discount of the bootstrap, a number or one per transition (gamma^n).
+        next_mask: bool ``(B, n_actions)``, the actions the argmax may choose; every row
+            must allow at least one.
 
     Returns:
         Targets of shape ``(B,)`` (no gradient flows through them).
     """
     with torch.no_grad():
+        if next_mask is not None:
+            next_q_online = next_q_online.masked_fill(~next_mask, float("-inf"))
         best = next_q_online.argmax(dim=-1, keepdim=True)
         bootstrap = next_q_target.gather(-1, best).squeeze(-1)
         not_done = 1.0 - terminated.to(rewards.dtype)
         return rewards + gamma * not_done * bootstrap
+
+
+def unsafe_action_loss(
+    q_values: Tensor, mask: Tensor, unsafe_q: float, kind: str = "mse", huber_delta: float = 1.0
+) -> Tensor:
+    """Loss that pushes the Q-value of every unsafe action down to ``unsafe_q``.
+
+    Only values above ``unsafe_q`` are pushed; safe actions (``mask`` true) are untouched.
+    The per-state sum over unsafe actions is averaged over the batch.
+
+    Args:
+        q_values: online Q-values, ``(B, n_actions)``.
+        mask: bool ``(B, n_actions)``, true for safe actions.
+        unsafe_q: the value unsafe actions are pushed to.
+        kind: ``mse`` or ``huber``, as :func:`td_loss`.
+        huber_delta: threshold of the Huber loss.
+    """
+    excess = (q_values - unsafe_q).clamp(min=0.0) * (~mask).to(q_values.dtype)
+    if kind == "mse":
+        per_action = excess.square()
+    elif kind == "huber":
+        per_action = F.huber_loss(
+            excess, torch.zeros_like(excess), delta=huber_delta, reduction="none"
+        )
+    else:
+        raise ValueError(f"unknown loss {kind!r}; expected 'mse' or 'huber'")
+    return per_action.sum(dim=-1).mean()
 
 
 def td_loss(q_taken: Tensor, target: Tensor, kind: str = "mse", huber_delta: float = 1.0) -> Tensor:

@@ -2,12 +2,17 @@
 
 Outputs of a run directory ``out``:
 
-- ``episodes.csv``: one row per finished episode (return, length, safety flags, speed...);
+- ``episodes.csv``: one row per finished episode (return, length, safety flags, speed, the
+  share of steps whose greedy action the shield would override...);
 - ``tb/``: TensorBoard scalars (``charts/episodic_return``, ``charts/epsilon``,
   ``charts/steps_per_second``, ``losses/td_loss``, ``losses/q_values``...), x = env steps;
 - ``checkpoints/``: the last checkpoint (see :mod:`explaindrive.agent.checkpoint`);
 - ``policy.pt`` + ``policy.json``: the final greedy policy and its card;
 - ``training_curve.png``: episode reward with its moving average (the paper's figure).
+
+The loop is pipelined but deterministic: while the workers simulate a step, the learner
+makes the updates owed for the transitions already stored, and a finished env resets while
+the others step; no decision depends on timing, so a run and its resumed copy are equal.
 
 Resume: the checkpoint holds the networks, the optimiser, the replay buffer, the counters,
 the RNG state and the episodes that were running; ``resume=True`` reloads it, truncates
@@ -44,16 +49,21 @@ from explaindrive.agent.checkpoint import (
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.schedule import EpisodePlan, plan_episode
+from explaindrive.agent.shield import runtime_mask, training_mask
 from explaindrive.agent.vec_env import RESET_FAILED, EnvFactory, VecEnv, make_vec_env
+from explaindrive.env.actions import N_ACTIONS
 
 log = logging.getLogger(__name__)
 
 CSV_FIELDS: tuple[str, ...] = (
     "episode", "env", "seed", "traffic_level", "stops", "return", "length", "env_steps",
     "epsilon", "collision", "red_light_run", "ped_violation", "speeding_steps",
-    "mean_speed_mps", "distance_m", "terminated", "truncated", "wall_time_s",
+    "shield_share", "shielded", "mean_speed_mps", "distance_m", "terminated", "truncated",
+    "wall_time_s",
 )  # fmt: skip
 SAFETY_FLAGS: tuple[str, ...] = ("collision", "red_light_run", "ped_violation")
+INFO_KEYS: tuple[str, ...] = ("speed_mps", "speeding", "distance_m", *SAFETY_FLAGS)
+"""The info keys the trainer reads; the env workers send only these."""
 MAX_RESET_ATTEMPTS = 5
 
 
@@ -76,26 +86,75 @@ def default_env_factory(config: TrainConfig) -> EnvFactory:
     return functools.partial(make_urban_drive_env, config.max_episode_steps)
 
 
+Transition = tuple[np.ndarray, int, float, np.ndarray, bool, float, np.ndarray, np.ndarray]
+"""(obs, action, return, next_obs, terminated, discount, mask, next_mask)"""
+
+
+class NStepQueue:
+    """Turns the steps of one episode into n-step transitions.
+
+    A transition leaves the queue when n steps have followed its state (return
+    r_0 + g r_1 + ... + g^(n-1) r_(n-1), bootstrapped from the state n steps later with
+    discount g^n), or when the episode ends (the shorter tail returns, each marked
+    terminated if the episode terminated).
+    """
+
+    def __init__(self, n: int, gamma: float) -> None:
+        self.n, self.gamma = n, gamma
+        self._steps: deque[tuple[np.ndarray, int, float, np.ndarray]] = deque()
+
+    def push(
+        self,
+        obs: np.ndarray,
+        action: int,
+        reward: float,
+        mask: np.ndarray,
+        next_obs: np.ndarray,
+        next_mask: np.ndarray,
+        terminated: bool,
+        done: bool,
+    ) -> list[Transition]:
+        """Add one step; returns the transitions it completes."""
+        self._steps.append((obs, action, reward, mask))
+        out: list[Transition] = []
+        while self._steps and (done or len(self._steps) >= self.n):
+            ret = sum(self.gamma**k * step[2] for k, step in enumerate(self._steps))
+            first_obs, first_action, _, first_mask = self._steps.popleft()
+            discount = self.gamma ** (len(self._steps) + 1)
+            out.append((first_obs, first_action, ret, next_obs, terminated and done, discount,
+                        first_mask, next_mask))  # fmt: skip
+        return out
+
+
 @dataclass
 class _Episode:
     """Running statistics of the episode an env is playing."""
 
     plan: EpisodePlan
+    shielded: bool
+    queue: NStepQueue
     ret: float = 0.0
     length: int = 0
     speed_sum: float = 0.0
     speeding_steps: int = 0
+    greedy_unsafe: int = 0
     flags: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(SAFETY_FLAGS, False))
     distance_m: float = 0.0
 
-    def record(self, reward: float, info: dict[str, Any]) -> None:
+    def record(self, reward: float, info: dict[str, Any], greedy_unsafe: bool) -> None:
         self.ret += reward
         self.length += 1
         self.speed_sum += float(info.get("speed_mps", 0.0))
         self.speeding_steps += int(bool(info.get("speeding", False)))
+        self.greedy_unsafe += int(greedy_unsafe)
         for key in SAFETY_FLAGS:
             self.flags[key] = self.flags[key] or bool(info.get(key, False))
         self.distance_m = float(info.get("distance_m", self.distance_m))
+
+    @property
+    def clean(self) -> bool:
+        """No greedy action needed overriding and nothing was violated."""
+        return not self.greedy_unsafe and not self.speeding_steps and not any(self.flags.values())
 
 
 @dataclass
@@ -110,6 +169,7 @@ class TrainResult:
     steps_per_s: float
     policy_path: Path
     curve_path: Path
+    stopped_early: bool = False
 
 
 def moving_average(values: np.ndarray, window: int) -> np.ndarray:
@@ -252,6 +312,7 @@ class Trainer:
         self.update_debt = 0.0
         self.wall_time_s = 0.0
         self.reset_failures = 0
+        self.clean_streak = 0  # consecutive finished episodes without override or violation
         self.recent_returns: deque[float] = deque(maxlen=config.moving_average_window)
 
         if resume:
@@ -272,6 +333,7 @@ class Trainer:
             "update_debt": self.update_debt,
             "wall_time_s": self.wall_time_s,
             "reset_failures": self.reset_failures,
+            "clean_streak": self.clean_streak,
             "recent_returns": list(self.recent_returns),
             "rng": self.rng.bit_generator.state,
             "torch_rng": torch.get_rng_state(),
@@ -293,6 +355,7 @@ class Trainer:
         self.update_debt = float(t["update_debt"])
         self.wall_time_s = float(t["wall_time_s"])
         self.reset_failures = int(t.get("reset_failures", 0))
+        self.clean_streak = int(t.get("clean_streak", 0))
         self.recent_returns.extend(float(r) for r in t["recent_returns"])
         self.rng.bit_generator.state = t["rng"]
         torch.set_rng_state(t["torch_rng"])
@@ -333,7 +396,8 @@ class Trainer:
         return None
 
     def run(self) -> TrainResult:
-        """Train until ``config.episodes`` episodes have finished; returns the summary."""
+        """Train until ``config.episodes`` episodes have finished (or the run is safe, with
+        ``stop_when_safe``); returns the summary."""
         from torch.utils.tensorboard import SummaryWriter
 
         c = self.config
@@ -347,44 +411,11 @@ class Trainer:
         tb = SummaryWriter(str(self.out_dir / "tb"), purge_step=self.env_steps or None)
         progress = _Progress(self.show_progress, c.episodes, self.episodes_done, f"train {c.mode}")
         vec: VecEnv | None = None
-        session_start, session_steps = time.perf_counter(), self.env_steps
-        wall_base = self.wall_time_s
+        self._session = (time.perf_counter(), self.env_steps, self.wall_time_s)
         try:
-            vec = make_vec_env(self.env_factory, c.envs, self.subprocess_envs)
-            episodes: dict[int, _Episode] = {}
-            obs = np.zeros((vec.num_envs, self.buffer.state_dim), dtype=np.float32)
-            self._start(vec, list(range(vec.num_envs)), episodes, obs)
-            while episodes:
-                active = sorted(episodes)
-                eps = self.learner.epsilon(self.env_steps)
-                actions = self.learner.act(obs[active], eps, self.rng)
-                next_obs, rewards, term, trunc, infos = vec.step(active, actions)
-                self.buffer.add(obs[active], actions, rewards, next_obs, term)
-                self.env_steps += len(active)
-                obs[active] = next_obs
-                self._train(tb, len(active))
-
-                now = time.perf_counter()
-                self.wall_time_s = wall_base + now - session_start
-                sps = (self.env_steps - session_steps) / max(now - session_start, 1e-9)
-                finished = []
-                for k, i in enumerate(active):
-                    ep = episodes[i]
-                    ep.record(float(rewards[k]), infos[k])
-                    if term[k] or trunc[k]:
-                        finished.append(i)
-                        self._log_episode(writer_csv, tb, i, ep, bool(term[k]), eps, sps)
-                        del episodes[i]
-                if finished:
-                    csv_file.flush()
-                    progress.update(
-                        self.episodes_done, self.recent_returns[-1],
-                        float(np.mean(self.recent_returns)), eps, sps,
-                    )  # fmt: skip
-                    self._start(vec, finished, episodes, obs)
-                    due = self.episodes_done % c.checkpoint_every_episodes == 0
-                    if due and self.episodes_done < c.episodes:
-                        self._checkpoint([ep.plan.index for ep in episodes.values()])
+            vec = make_vec_env(self.env_factory, c.envs, self.subprocess_envs, INFO_KEYS)
+            loop = _Loop(self, vec, tb, writer_csv, csv_file, progress)
+            loop.run()
             self._checkpoint([])
         finally:
             progress.close()
@@ -394,47 +425,33 @@ class Trainer:
                 vec.close()
         return self._finish()
 
-    def _start(
-        self, vec: VecEnv, indices: list[int], episodes: dict[int, _Episode], obs: np.ndarray
-    ) -> None:
-        """Start the next planned episodes on the free envs ``indices``."""
-        starts: list[tuple[int, EpisodePlan]] = []
-        for i in indices:
-            plan = self._next_plan()
-            if plan is None:
-                break
-            starts.append((i, plan))
-        if not starts:
-            return
-        for attempt in range(MAX_RESET_ATTEMPTS):
-            env_ids = [i for i, _ in starts]
-            plans = [p for _, p in starts]
-            first, infos = vec.reset(
-                env_ids, [p.seed for p in plans], [p.reset_options() for p in plans]
-            )
-            retry = []
-            for k, (i, plan) in enumerate(starts):
-                if RESET_FAILED in infos[k]:
-                    self.reset_failures += 1
-                    log.warning("episode %d (seed %d) could not start: %s; new seed",
-                                plan.index, plan.seed, infos[k][RESET_FAILED])  # fmt: skip
-                    retry.append((i, replace(plan, seed=reseed(plan.seed, attempt))))
-                else:
-                    obs[i] = first[k]
-                    episodes[i] = _Episode(plan)
-            if not retry:
-                return
-            starts = retry
-        raise RuntimeError(
-            f"envs {[i for i, _ in starts]} failed to start an episode {MAX_RESET_ATTEMPTS} times"
-        )
+    @property
+    def safe_enough(self) -> bool:
+        """Whether ``stop_when_safe`` consecutive episodes ran clean."""
+        n = self.config.stop_when_safe
+        return n is not None and self.clean_streak >= n
 
-    def _train(self, tb: Any, new_transitions: int) -> None:
-        """Run the gradient updates owed for ``new_transitions`` (one per ``train_frequency``)."""
+    def _tick(self) -> float:
+        """Update the wall time; returns this session's env steps per second."""
+        start, steps, wall = self._session
+        now = time.perf_counter()
+        self.wall_time_s = wall + now - start
+        return (self.env_steps - steps) / max(now - start, 1e-9)
+
+    def _new_episode(self, plan: EpisodePlan) -> _Episode:
         c = self.config
-        if self.env_steps < c.learning_starts or len(self.buffer) < c.batch_size:
-            return
-        self.update_debt += new_transitions / c.train_frequency
+        shielded = c.safe_learning and plan.index < c.shielded_fraction * c.episodes
+        return _Episode(plan, shielded, NStepQueue(c.n_step, c.gamma))
+
+    def _owe(self, new_transitions: int) -> None:
+        """Record the updates owed for ``new_transitions`` (one per ``train_frequency``)."""
+        c = self.config
+        if self.env_steps >= c.learning_starts and len(self.buffer) >= c.batch_size:
+            self.update_debt += new_transitions / c.train_frequency
+
+    def _train(self, tb: Any) -> None:
+        """Run the gradient updates owed."""
+        c = self.config
         while self.update_debt >= 1.0:
             self.update_debt -= 1.0
             stats = self.learner.update(self.buffer.sample(c.batch_size, self.rng), self.env_steps)
@@ -442,6 +459,8 @@ class Trainer:
                 tb.add_scalar("losses/td_loss", stats["td_loss"], self.env_steps)
                 tb.add_scalar("losses/q_values", stats["q_values"], self.env_steps)
                 tb.add_scalar("charts/learning_rate", stats["learning_rate"], self.env_steps)
+                if c.safe_learning:
+                    tb.add_scalar("losses/unsafe_loss", stats["unsafe_loss"], self.env_steps)
                 if c.grad_clip_norm is not None:
                     tb.add_scalar("losses/grad_norm", stats["grad_norm"], self.env_steps)
 
@@ -450,14 +469,17 @@ class Trainer:
         eps: float, sps: float,
     ) -> None:  # fmt: skip
         self.episodes_done += 1
+        self.clean_streak = self.clean_streak + 1 if ep.clean else 0
         self.recent_returns.append(ep.ret)
+        shield_share = ep.greedy_unsafe / max(ep.length, 1)
         mean_speed = ep.speed_sum / max(ep.length, 1)
         row = {
             "episode": ep.plan.index, "env": env, "seed": ep.plan.seed,
             "traffic_level": ep.plan.traffic_level, "stops": int(ep.plan.has_stops),
             "return": round(ep.ret, 4), "length": ep.length, "env_steps": self.env_steps,
             "epsilon": round(eps, 5), **{k: int(v) for k, v in ep.flags.items()},
-            "speeding_steps": ep.speeding_steps, "mean_speed_mps": round(mean_speed, 4),
+            "speeding_steps": ep.speeding_steps, "shield_share": round(shield_share, 5),
+            "shielded": int(ep.shielded), "mean_speed_mps": round(mean_speed, 4),
             "distance_m": round(ep.distance_m, 2), "terminated": int(terminated),
             "truncated": int(not terminated), "wall_time_s": round(self.wall_time_s, 2),
         }  # fmt: skip
@@ -471,6 +493,7 @@ class Trainer:
         for key, value in ep.flags.items():
             tb.add_scalar(f"safety/{key}", float(value), step)
         tb.add_scalar("safety/speeding_steps", ep.speeding_steps, step)
+        tb.add_scalar("safety/shield_share", shield_share, step)
 
     def _finish(self) -> TrainResult:
         c = self.config
@@ -486,6 +509,7 @@ class Trainer:
             "steps_per_s": round(steps_per_s, 1),
             "num_envs": c.envs,
             "reset_failures": self.reset_failures,
+            "stopped_early": self.safe_enough,
             "final_mean_return": (
                 float(np.mean(self.recent_returns)) if self.recent_returns else None
             ),
@@ -503,8 +527,140 @@ class Trainer:
         )
         return TrainResult(
             self.out_dir, self.episodes_done, self.env_steps, self.learner.updates,
-            self.wall_time_s, steps_per_s, policy_path, curve,
+            self.wall_time_s, steps_per_s, policy_path, curve, self.safe_enough,
         )  # fmt: skip
+
+
+class _Loop:
+    """One session of the pipelined collection loop of a :class:`Trainer`."""
+
+    def __init__(
+        self, trainer: Trainer, vec: VecEnv, tb: Any, writer: csv.DictWriter, csv_file: Any,
+        progress: _Progress,
+    ) -> None:  # fmt: skip
+        self.t = trainer
+        self.vec = vec
+        self.tb, self.writer, self.csv_file, self.progress = tb, writer, csv_file, progress
+        n, dim = vec.num_envs, trainer.buffer.state_dim
+        self.obs = np.zeros((n, dim), dtype=np.float32)
+        self.masks = np.ones((n, N_ACTIONS), dtype=np.bool_)  # not penalised in obs
+        self.allowed = np.ones((n, N_ACTIONS), dtype=np.bool_)  # kept by the shield in obs
+        self.episodes: dict[int, _Episode] = {}
+        self.starting: dict[int, EpisodePlan] = {}
+
+    def run(self) -> None:
+        t, c = self.t, self.t.config
+        self._request(list(range(self.vec.num_envs)))
+        while not t.safe_enough:
+            if self.starting and not self.episodes:
+                self._await_starts()
+            if not self.episodes:
+                return
+            active = sorted(self.episodes)
+            eps = t.learner.epsilon(t.env_steps)
+            q = t.learner.q_values(self.obs[active])
+            greedy = q.argmax(axis=-1)
+            greedy_unsafe = ~self.allowed[active, greedy]
+            act_mask = self.allowed[active].copy()
+            act_mask[[not self.episodes[i].shielded for i in active]] = True
+            actions = t.learner.explore(q, eps, t.rng, act_mask)
+            self.vec.step_async(active, actions)
+            t._train(self.tb)  # overlaps the workers' step
+            next_obs, rewards, term, trunc, infos = self.vec.step_wait(active)
+            self._await_starts()  # resets asked last iteration ran during this one
+            next_allowed = runtime_mask(next_obs)
+            self._store(active, actions, rewards, next_obs, next_allowed, term, trunc)
+            t.env_steps += len(active)
+            t._owe(len(active))
+            self.obs[active] = next_obs
+            self.masks[active] = training_mask(next_obs)
+            self.allowed[active] = next_allowed
+            sps = t._tick()
+            finished = []
+            for k, i in enumerate(active):
+                ep = self.episodes[i]
+                ep.record(float(rewards[k]), infos[k], bool(greedy_unsafe[k]))
+                if term[k] or trunc[k]:
+                    finished.append(i)
+                    t._log_episode(self.writer, self.tb, i, ep, bool(term[k]), eps, sps)
+                    del self.episodes[i]
+            if finished:
+                self.csv_file.flush()
+                self.progress.update(
+                    t.episodes_done, t.recent_returns[-1], float(np.mean(t.recent_returns)),
+                    eps, sps,
+                )  # fmt: skip
+                self._request(finished)
+                due = t.episodes_done % c.checkpoint_every_episodes == 0
+                if due and t.episodes_done < c.episodes and not t.safe_enough:
+                    t._checkpoint(self.running())
+        if t.safe_enough:
+            log.info("%d episodes in a row ran clean: training ends", t.clean_streak)
+
+    def running(self) -> list[int]:
+        """Indices of the episodes under way (restarted on resume)."""
+        plans = [ep.plan for ep in self.episodes.values()] + list(self.starting.values())
+        return sorted(p.index for p in plans)
+
+    def _store(
+        self, active: list[int], actions: np.ndarray, rewards: np.ndarray, next_obs: np.ndarray,
+        next_allowed: np.ndarray, term: np.ndarray, trunc: np.ndarray,
+    ) -> None:  # fmt: skip
+        """Store the n-step transitions completed: each with the actions not penalised in its
+        state and the actions the target may choose in its bootstrap state."""
+        rows: list[Transition] = []
+        for k, i in enumerate(active):
+            rows += self.episodes[i].queue.push(
+                self.obs[i].copy(), int(actions[k]), float(rewards[k]), self.masks[i].copy(),
+                next_obs[k], next_allowed[k], bool(term[k]), bool(term[k] or trunc[k]),
+            )  # fmt: skip
+        if rows:
+            o, a, r, o2, d, g, m, m2 = (np.asarray(col) for col in zip(*rows, strict=True))
+            self.t.buffer.add(o, a, r, o2, d, g, m, m2)
+
+    def _request(self, indices: list[int]) -> None:
+        """Ask the free envs ``indices`` to start the next planned episodes."""
+        starts = {}
+        for i in indices:
+            plan = self.t._next_plan()
+            if plan is None:
+                break
+            starts[i] = plan
+        self._reset(starts)
+
+    def _reset(self, starts: dict[int, EpisodePlan]) -> None:
+        if starts:
+            ids = list(starts)
+            plans = list(starts.values())
+            self.vec.reset_async(ids, [p.seed for p in plans], [p.reset_options() for p in plans])
+            self.starting.update(starts)
+
+    def _await_starts(self) -> None:
+        """Collect the resets asked for; an episode that cannot start gets a new seed."""
+        for attempt in range(MAX_RESET_ATTEMPTS):
+            if not self.starting:
+                return
+            ids = sorted(self.starting)
+            first, infos = self.vec.reset_wait(ids)
+            retry = {}
+            for k, i in enumerate(ids):
+                plan = self.starting.pop(i)
+                if RESET_FAILED in infos[k]:
+                    self.t.reset_failures += 1
+                    log.warning("episode %d (seed %d) could not start: %s; new seed",
+                                plan.index, plan.seed, infos[k][RESET_FAILED])  # fmt: skip
+                    retry[i] = replace(plan, seed=reseed(plan.seed, attempt))
+                else:
+                    self.obs[i] = first[k]
+                    self.masks[i] = training_mask(first[k])
+                    self.allowed[i] = runtime_mask(first[k])
+                    self.episodes[i] = self.t._new_episode(plan)
+            self._reset(retry)
+        if self.starting:
+            raise RuntimeError(
+                f"envs {sorted(self.starting)} failed to start an episode "
+                f"{MAX_RESET_ATTEMPTS} times"
+            )
 
 
 def train(

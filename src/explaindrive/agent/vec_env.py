@@ -4,6 +4,10 @@ libsumo runs a single simulation per process, so parallel collection needs proce
 Unlike Gymnasium's vector envs there is no automatic reset: the trainer resets a finished
 env itself, because every episode gets its own seed, traffic level and command schedule.
 :class:`SyncVecEnv` offers the same interface in-process (tests, ``--envs 1``).
+
+Steps and resets are split into a request (``*_async``) and its answer (``*_wait``), so the
+caller can learn while the workers simulate. Workers may return only some info keys
+(``info_keys``), which keeps the per-step pipe traffic small.
 """
 
 from __future__ import annotations
@@ -34,14 +38,22 @@ class VecEnv(Protocol):
 
     num_envs: int
 
-    def reset(
+    def reset_async(
         self, indices: Sequence[int], seeds: Sequence[int], options: Sequence[dict[str, Any]]
-    ) -> tuple[np.ndarray, list[dict[str, Any]]]:
-        """Reset the envs ``indices``; returns their observations and infos."""
+    ) -> None:
+        """Ask the envs ``indices`` to start an episode."""
         ...
 
-    def step(self, indices: Sequence[int], actions: np.ndarray) -> StepResult:
-        """Step the envs ``indices``; returns (obs, rewards, terminated, truncated, infos)."""
+    def reset_wait(self, indices: Sequence[int]) -> tuple[np.ndarray, list[dict[str, Any]]]:
+        """The observations and infos of the resets asked of ``indices``."""
+        ...
+
+    def step_async(self, indices: Sequence[int], actions: np.ndarray) -> None:
+        """Ask the envs ``indices`` to step."""
+        ...
+
+    def step_wait(self, indices: Sequence[int]) -> StepResult:
+        """(obs, rewards, terminated, truncated, infos) of the steps asked of ``indices``."""
         ...
 
     def close(self) -> None:
@@ -49,26 +61,64 @@ class VecEnv(Protocol):
         ...
 
 
-class SyncVecEnv:
-    """All environments in the calling process."""
+def reset(
+    vec: VecEnv,
+    indices: Sequence[int],
+    seeds: Sequence[int],
+    options: Sequence[dict[str, Any]],
+) -> tuple[np.ndarray, list[dict[str, Any]]]:
+    """Reset and wait."""
+    vec.reset_async(indices, seeds, options)
+    return vec.reset_wait(indices)
 
-    def __init__(self, factories: Sequence[EnvFactory]) -> None:
+
+def step(vec: VecEnv, indices: Sequence[int], actions: np.ndarray) -> StepResult:
+    """Step and wait."""
+    vec.step_async(indices, actions)
+    return vec.step_wait(indices)
+
+
+def _select(info: dict[str, Any], keys: tuple[str, ...] | None) -> dict[str, Any]:
+    if keys is None:
+        return info
+    return {k: info[k] for k in keys if k in info}
+
+
+class SyncVecEnv:
+    """All environments in the calling process (a request runs when its answer is asked)."""
+
+    def __init__(
+        self, factories: Sequence[EnvFactory], info_keys: tuple[str, ...] | None = None
+    ) -> None:
         self.envs = [f() for f in factories]
         self.num_envs = len(self.envs)
+        self.info_keys = info_keys
+        self._resets: dict[int, tuple[int, dict[str, Any]]] = {}
+        self._actions: dict[int, int] = {}
 
-    def reset(
+    def reset_async(
         self, indices: Sequence[int], seeds: Sequence[int], options: Sequence[dict[str, Any]]
-    ) -> tuple[np.ndarray, list[dict[str, Any]]]:
-        """See :meth:`VecEnv.reset`."""
-        results = [
-            _safe_reset(self.envs[i], int(s), o)
-            for i, s, o in zip(indices, seeds, options, strict=True)
-        ]
+    ) -> None:
+        """See :meth:`VecEnv.reset_async`."""
+        for i, s, o in zip(indices, seeds, options, strict=True):
+            self._resets[i] = (int(s), o)
+
+    def reset_wait(self, indices: Sequence[int]) -> tuple[np.ndarray, list[dict[str, Any]]]:
+        """See :meth:`VecEnv.reset_wait`."""
+        results = [_safe_reset(self.envs[i], *self._resets.pop(i)) for i in indices]
         return np.stack([r[0] for r in results]).astype(np.float32), [r[1] for r in results]
 
-    def step(self, indices: Sequence[int], actions: np.ndarray) -> StepResult:
-        """See :meth:`VecEnv.step`."""
-        results = [self.envs[i].step(int(a)) for i, a in zip(indices, actions, strict=True)]
+    def step_async(self, indices: Sequence[int], actions: np.ndarray) -> None:
+        """See :meth:`VecEnv.step_async`."""
+        for i, a in zip(indices, actions, strict=True):
+            self._actions[i] = int(a)
+
+    def step_wait(self, indices: Sequence[int]) -> StepResult:
+        """See :meth:`VecEnv.step_wait`."""
+        results = []
+        for i in indices:
+            obs, rew, term, trunc, info = self.envs[i].step(self._actions.pop(i))
+            results.append((obs, rew, term, trunc, _select(info, self.info_keys)))
         return _stack(results)
 
     def close(self) -> None:
@@ -103,7 +153,7 @@ def _safe_reset(env: gym.Env, seed: int, options: dict[str, Any]) -> tuple[Any, 
         return np.full(shape, np.nan, dtype=np.float32), {RESET_FAILED: str(exc)}
 
 
-def _worker(conn: Connection, factory: EnvFactory) -> None:
+def _worker(conn: Connection, factory: EnvFactory, info_keys: tuple[str, ...] | None) -> None:
     """Worker loop: build the env, then serve ``reset``/``step``/``close`` requests."""
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     if "torch" in sys.modules:  # keep any torch use in the env to one thread
@@ -115,7 +165,8 @@ def _worker(conn: Connection, factory: EnvFactory) -> None:
         while True:
             cmd, data = conn.recv()
             if cmd == "step":
-                conn.send(("ok", env.step(int(data))))
+                obs, rew, term, trunc, info = env.step(int(data))
+                conn.send(("ok", (obs, rew, term, trunc, _select(info, info_keys))))
             elif cmd == "reset":
                 seed, options = data
                 conn.send(("ok", _safe_reset(env, seed, options)))
@@ -139,6 +190,7 @@ class SubprocVecEnv:
 
     Args:
         factories: one picklable env factory per worker.
+        info_keys: the info keys the workers return (all when ``None``).
         start_method: multiprocessing start method; ``spawn`` keeps the workers free of the
             parent's torch threads and of any simulation state.
 
@@ -146,7 +198,12 @@ class SubprocVecEnv:
         RuntimeError: naming the env, if a worker fails to build its env or to step it.
     """
 
-    def __init__(self, factories: Sequence[EnvFactory], start_method: str = "spawn") -> None:
+    def __init__(
+        self,
+        factories: Sequence[EnvFactory],
+        info_keys: tuple[str, ...] | None = None,
+        start_method: str = "spawn",
+    ) -> None:
         ctx: Any = mp.get_context(start_method)
         self.num_envs = len(factories)
         self._conns: list[Connection] = []
@@ -155,7 +212,10 @@ class SubprocVecEnv:
         for i, factory in enumerate(factories):
             parent, child = ctx.Pipe()
             proc = ctx.Process(
-                target=_worker, args=(child, factory), name=f"explaindrive-env-{i}", daemon=True
+                target=_worker,
+                args=(child, factory, info_keys),
+                name=f"explaindrive-env-{i}",
+                daemon=True,
             )
             proc.start()
             child.close()
@@ -178,19 +238,25 @@ class SubprocVecEnv:
             raise RuntimeError(f"env worker {i} failed:\n{payload}")
         return payload
 
-    def reset(
+    def reset_async(
         self, indices: Sequence[int], seeds: Sequence[int], options: Sequence[dict[str, Any]]
-    ) -> tuple[np.ndarray, list[dict[str, Any]]]:
-        """See :meth:`VecEnv.reset`; the envs reset in parallel."""
+    ) -> None:
+        """See :meth:`VecEnv.reset_async`; the envs reset in parallel."""
         for i, s, o in zip(indices, seeds, options, strict=True):
             self._conns[i].send(("reset", (int(s), o)))
+
+    def reset_wait(self, indices: Sequence[int]) -> tuple[np.ndarray, list[dict[str, Any]]]:
+        """See :meth:`VecEnv.reset_wait`."""
         results = [self._recv(i) for i in indices]
         return np.stack([r[0] for r in results]).astype(np.float32), [r[1] for r in results]
 
-    def step(self, indices: Sequence[int], actions: np.ndarray) -> StepResult:
-        """See :meth:`VecEnv.step`; the envs step in parallel."""
+    def step_async(self, indices: Sequence[int], actions: np.ndarray) -> None:
+        """See :meth:`VecEnv.step_async`; the envs step in parallel."""
         for i, a in zip(indices, actions, strict=True):
             self._conns[i].send(("step", int(a)))
+
+    def step_wait(self, indices: Sequence[int]) -> StepResult:
+        """See :meth:`VecEnv.step_wait`."""
         return _stack([self._recv(i) for i in indices])
 
     def close(self) -> None:
@@ -211,10 +277,17 @@ class SubprocVecEnv:
             conn.close()
 
 
-def make_vec_env(factory: EnvFactory, num_envs: int, subprocess: bool | None = None) -> VecEnv:
+def make_vec_env(
+    factory: EnvFactory,
+    num_envs: int,
+    subprocess: bool | None = None,
+    info_keys: tuple[str, ...] | None = None,
+) -> VecEnv:
     """``num_envs`` copies of ``factory``'s env; in subprocesses unless ``num_envs == 1``."""
     if num_envs <= 0:
         raise ValueError(f"num_envs must be > 0, got {num_envs}")
     use_procs = num_envs > 1 if subprocess is None else subprocess
     factories = [factory] * num_envs
-    return SubprocVecEnv(factories) if use_procs else SyncVecEnv(factories)
+    if use_procs:
+        return SubprocVecEnv(factories, info_keys)
+    return SyncVecEnv(factories, info_keys)

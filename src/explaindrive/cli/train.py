@@ -64,7 +64,7 @@ def resolve_config(
         if config_file is not None:
             data.update(load_config_file(config_file))
         return TrainConfig.from_dict({**data, **changes})
-    return build_config(preset or "fast", config_file, changes)
+    return build_config(preset or "safe", config_file, changes)
 
 
 def train_command(
@@ -83,7 +83,7 @@ def train_command(
     ] = False,
     preset: Annotated[
         str | None,
-        typer.Option("--preset", help="paper or fast (default: fast; the run's own on --resume)."),
+        typer.Option("--preset", help="safe or paper (default: safe; the run's own on --resume)."),
     ] = None,
     seed: Annotated[int | None, typer.Option("--seed", help="Base seed of the run.")] = None,
     config_file: Annotated[
