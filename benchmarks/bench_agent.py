@@ -1,6 +1,6 @@
 """Agent benchmark: learner updates/s, batched action selection, replay memory.
 
-Usage: ``python benchmarks/bench_agent.py [--preset fast|paper] [--updates 2000]``
+Usage: ``python benchmarks/bench_agent.py [--preset safe|paper] [--updates 2000]``
 """
 
 from __future__ import annotations
@@ -17,12 +17,13 @@ from rich.table import Table
 from explaindrive.agent.buffer import ReplayBuffer, replay_nbytes
 from explaindrive.agent.config import preset
 from explaindrive.agent.learner import D3QNLearner
+from explaindrive.agent.shield import training_mask
 from explaindrive.env.state import STATE_HIGH, STATE_LOW
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--preset", default="fast", choices=["fast", "paper"])
+    parser.add_argument("--preset", default="safe", choices=["safe", "paper"])
     parser.add_argument("--updates", type=int, default=2000)
     parser.add_argument("--fill", type=int, default=200_000, help="transitions to store")
     args = parser.parse_args()
@@ -36,7 +37,9 @@ def main() -> None:
     t0 = time.perf_counter()
     for start in range(0, args.fill, 2):  # two envs per vector step
         sl = slice(start, start + 2)
-        buffer.add(obs[sl], rng.integers(0, 7, 2), rng.normal(size=2), obs[sl], np.zeros(2, bool))
+        mask = training_mask(obs[sl])
+        buffer.add(obs[sl], rng.integers(0, 7, 2), rng.normal(size=2), obs[sl], np.zeros(2, bool),
+                   config.gamma**config.n_step, mask, mask)  # fmt: skip
     add_rate = args.fill / (time.perf_counter() - t0)
     rss1 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 

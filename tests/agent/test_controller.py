@@ -107,3 +107,16 @@ def test_stop_guard_keeps_the_latency_bound(tmp_path: Path) -> None:
     assert changes == [-1, -1, -1, -3]
     bare = MergedController(gentle, gentle, Command.STOP, use_shield=False)
     assert bare.act(OBS) == 2  # without the shield the network decides alone
+
+
+def test_overrides_are_counted_with_and_without_the_shield(tmp_path: Path) -> None:
+    """+3 m/s from 12 m/s would reach 15 > 13.9: the shield replaces it (or would)."""
+    eager = QPolicy.load(constant_policy(tmp_path, "eager", 6))
+    fast = OBS.copy()
+    fast[1] = 12.0
+    # shielded: the next-best action; the others tie at 0 and the first of them, -3, is safe
+    for use_shield, expected in ((True, 0), (False, 6)):
+        ctrl = MergedController(eager, eager, use_shield=use_shield)
+        assert ctrl.act(OBS) == 6 and not ctrl.last_override  # 8 m/s: +3 is fine
+        assert ctrl.act(fast) == expected and ctrl.last_override
+        assert (ctrl.steps, ctrl.overrides) == (2, 1)

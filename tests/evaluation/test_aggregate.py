@@ -128,3 +128,12 @@ def test_speed_panels_take_each_run_its_own_traces() -> None:
         "fast + stops": [(5.0, 0.0)],
     }
     assert _speed_panels(plan, by_run, ("krauss",)) == {"krauss": [(7.0,)]}  # type: ignore[arg-type]
+
+
+def test_shield_line_gives_the_share() -> None:
+    from explaindrive.evaluation.tables import shield_line
+
+    assert shield_line(3, 400, True) == (
+        "Safety shield: replaced the network's action in 3 of 400 steps (0.75 %)."
+    )
+    assert "would have replaced (shield off)" in shield_line(0, 0, False)

@@ -77,7 +77,10 @@ class MergedController:
         comfort: the comfort-driving policy.
         command: the initial command (stop starts on the fast agent).
         use_shield: pass the greedy action through the kinematic safety shield
-            (:mod:`explaindrive.agent.shield`); ``overrides`` counts its interventions.
+            (:mod:`explaindrive.agent.shield`). Either way ``overrides`` counts the steps
+            in which the shield replaced the network's choice (or, without the shield,
+            would have), ``steps`` the actions chosen, and ``last_override`` tells whether
+            the last action was such a step.
     """
 
     def __init__(
@@ -92,6 +95,8 @@ class MergedController:
         self.command = Command.FAST
         self.use_shield = use_shield
         self.overrides = 0
+        self.steps = 0
+        self.last_override = False
         self._stop_steps_left: int | None = None  # under STOP: steps left to a standstill
         self.set_command(command)
 
@@ -144,14 +149,15 @@ class MergedController:
     def act(self, obs: np.ndarray) -> int:
         """Action of the active agent for a raw observation under the current command."""
         x = self.observation(obs)
-        if not self.use_shield:
-            return self.policy.act(x)
         steps_left = None
         if self.command is Command.STOP:
             if self._stop_steps_left is None:  # the first step under this STOP
                 self._stop_steps_left = stop_latency_bound(float(x[V_EGO]))
             steps_left = self._stop_steps_left
             self._stop_steps_left = max(1, self._stop_steps_left - 1)
-        decision = shield(x, self.policy.q_values(x), steps_left)
+        q_values = self.policy.q_values(x)
+        decision = shield(x, q_values, steps_left)
+        self.steps += 1
+        self.last_override = decision.overridden
         self.overrides += int(decision.overridden)
-        return decision.action
+        return decision.action if self.use_shield else int(np.argmax(q_values))

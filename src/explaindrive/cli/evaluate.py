@@ -122,6 +122,10 @@ def evaluate_command(
     out.print(tables.paper_table([summary]) + "\n")
     out.print(tables.level_table([summary]) + "\n")
     out.print(tables.safety_table([summary]) + "\n")
+    if spec.kind != "baseline":
+        steps = sum(r.result.steps for r in records)
+        overrides = sum(r.shield_overrides for r in records)
+        out.print(tables.shield_line(overrides, steps, spec.shield) + "\n")
     if episodes:
         out.print(tables.episode_table(
             [(r.spec.seed, r.spec.traffic_level, r.result) for r in records]

@@ -39,7 +39,8 @@ class EpisodeRecord:
         result: the episode's figures (see :mod:`explaindrive.env.metrics`).
         speeds_mps: ego speed after each step [m/s].
         commands: the command under which each step's action was taken.
-        shield_overrides: steps in which the safety shield replaced the policy's action.
+        shield_overrides: steps in which the safety shield replaced the policy's action
+            (with ``--no-shield``: would have replaced it).
     """
 
     spec: EpisodeSpec

@@ -128,3 +128,13 @@ def episode_table(rows: Sequence[tuple[int, float, EpisodeResult]]) -> str:
         for seed, level, r in rows
     ]  # fmt: skip
     return _table(header, body)
+
+
+def shield_line(overrides: int, steps: int, applied: bool) -> str:
+    """How often the safety shield replaced (or, off, would have replaced) the network."""
+    share = 100.0 * overrides / steps if steps else 0.0
+    verb = "replaced" if applied else "would have replaced (shield off)"
+    return (
+        f"Safety shield: {verb} the network's action in {overrides} of {steps} steps "
+        f"({share:.2f} %)."
+    )
