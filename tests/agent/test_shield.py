@@ -127,3 +127,10 @@ def test_where_nothing_is_safe_the_hardest_braking_is_allowed() -> None:
     assert not safe_action_mask(wall).any()
     assert training_mask(wall).tolist() == [True] + [False] * 6
     assert runtime_mask(wall).tolist() == [True] + [False] * 6
+
+
+def test_standing_at_the_line_when_it_turns_yellow_is_no_dilemma() -> None:
+    # stopped 0.7 m before the line: it can stay; pulling away would cross at red
+    standing = obs(v=0, d_lead=0.7, dv=0, d_tl=0.7, tls=1)
+    assert runtime_mask(standing).tolist() == [True] * 4 + [False] * 3
+    assert training_mask(standing).tolist() == [True] * 4 + [False] * 3

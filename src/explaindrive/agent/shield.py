@@ -7,6 +7,8 @@ An action is safe when, after it, the ego could still stop braking at -3 m/s per
 - before a red or yellow light and before an occupied crossing (the virtual leaders);
 - without exceeding the posted limit (above it, only the hardest braking is safe).
 
+Standing still after the step is safe with respect to every stop line and leader.
+
 A yellow light that even the hardest braking cannot stop for is the dilemma zone: the
 ego goes on without slowing down, since braking would only leave it on the junction at
 red. At run time (:func:`shield`) braking there is unsafe; the training mask
@@ -61,8 +63,10 @@ def braking_distance(speed_mps: float, brake_mps: float = MAX_BRAKE_MPS) -> floa
 
 
 def _stopping_need(v_new: NDArray[np.float64]) -> NDArray[np.float64]:
-    """[m] from the ego's front to where it stands still after this step and braking."""
-    return v_new + braking_distances(v_new) + MARGIN_M
+    """[m] from the ego's front to where it stands still after this step and braking, plus
+    the margin; 0 for a car that stands still after this step (it moves no further)."""
+    moving = v_new > 0.0
+    return np.where(moving, v_new + braking_distances(v_new) + MARGIN_M, 0.0)
 
 
 def steps_to_stop(speed_mps: NDArray[np.floating] | float) -> NDArray[np.float64]:
