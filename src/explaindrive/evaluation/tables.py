@@ -24,7 +24,7 @@ def _row(cells: Sequence[str]) -> str:
     return "| " + " | ".join(cells) + " |"
 
 
-def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     lines = [_row(header), _row(["---"] * len(header))]
     lines += [_row(r) for r in rows]
     return "\n".join(lines)
@@ -55,7 +55,7 @@ def paper_table(summaries: Sequence[RunSummary], with_paper: bool = True) -> str
         paper = paper_row(s.name) if with_paper else None
         if paper is not None:
             rows.append(_paper_cells(paper, levels))
-    return _table(header, rows)
+    return markdown_table(header, rows)
 
 
 def _paper_cells(p: PaperRow, levels: Sequence[float]) -> list[str]:
@@ -87,7 +87,7 @@ def level_table(summaries: Sequence[RunSummary]) -> str:
                 speed + (f" ({pv:.3f})" if pv is not None else ""),
             ]
         rows.append(cells)
-    return _table(header, rows)
+    return markdown_table(header, rows)
 
 
 def safety_table(summaries: Sequence[RunSummary]) -> str:
@@ -108,7 +108,7 @@ def safety_table(summaries: Sequence[RunSummary]) -> str:
             str(o.stop_bound_misses), str(o.unfinished_stops), f"{o.arrived}/{o.episodes}",
             fmt(o.travel_time_mean_s, 1),
         ])  # fmt: skip
-    return _table(header, rows)
+    return markdown_table(header, rows)
 
 
 def episode_table(rows: Sequence[tuple[int, float, EpisodeResult]]) -> str:
@@ -127,7 +127,7 @@ def episode_table(rows: Sequence[tuple[int, float, EpisodeResult]]) -> str:
         ]
         for seed, level, r in rows
     ]  # fmt: skip
-    return _table(header, body)
+    return markdown_table(header, body)
 
 
 def shield_line(overrides: int, steps: int, applied: bool) -> str:
