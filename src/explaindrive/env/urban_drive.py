@@ -31,6 +31,7 @@ from explaindrive.env.config import EnvConfig
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.reward import (
     STOP_REASON_GAP_M,
+    RewardTerms,
     StepFeatures,
     reward_terms,
     time_headway,
@@ -67,6 +68,39 @@ class _Leader:
     speed_mps: float
     length_m: float
     virtual: bool
+
+
+@dataclass(frozen=True, slots=True)
+class _Motion:
+    """Outcome of one simulated step for the ego."""
+
+    speed_mps: float
+    collided: bool
+    arrived: bool
+    ego: Any  # the ego's subscription results; None once it has left the simulation
+
+
+@dataclass(frozen=True, slots=True)
+class _Step:
+    """Everything one step produced that the reward and the info are computed from."""
+
+    command: Command
+    change: int
+    accel: float
+    jerk: float
+    motion: _Motion
+    leader: _Leader | None
+    real: _Leader | None
+    limit_mps: float  # the posted limit the agent observed before the step
+    red_run: bool
+    ped_violation: bool
+
+    @property
+    def ttc_s(self) -> float:
+        """TTC w.r.t. the effective leader (inf without one)."""
+        if self.leader is None:
+            return math.inf
+        return time_to_collision(self.leader.gap_m, self.motion.speed_mps - self.leader.speed_mps)
 
 
 @dataclass(slots=True)
@@ -222,16 +256,39 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         if ep.done:
             raise RuntimeError("the episode is over; call reset() before step()")
         change = speed_change(action)
+        cmd, prev_obs, prev_pos = ep.command, self._last_obs, ep.pos_m
+        motion = self._advance(ep, change)
+        if self.config.ego_model != "agent":
+            change = round(motion.speed_mps - ep.speed_mps)
+        accel = motion.speed_mps - ep.speed_mps
+        jerk = accel - ep.accel_mps2
+        # violations are judged on what the ego saw before this step's observation
+        red_run = self._ran_red_light(prev_pos, ep.pos_m)
+        ped_violation = self._violated_crossing(prev_pos, ep.pos_m)
+        ep.speed_mps, ep.accel_mps2 = motion.speed_mps, accel
+        self._apply_schedule(ep.steps * STEP_LENGTH_S)
+        obs, leader, real = self._next_observation(motion, prev_obs)
+        step = _Step(
+            command=cmd, change=change, accel=accel, jerk=jerk, motion=motion, leader=leader,
+            real=real, limit_mps=float(prev_obs[S.V_LIM]), red_run=red_run,
+            ped_violation=ped_violation,
+        )  # fmt: skip
+        terms = reward_terms(cmd, self._features(step))
+        terminated = motion.collided or motion.arrived
+        truncated = not terminated and ep.steps >= self.config.max_steps
+        ep.done = terminated or truncated
+        self._last_obs = obs
+        return self._output(obs), terms.total, terminated, truncated, self._info(step, terms)
+
+    # ------------------------------------------------------------------ step pieces
+    def _advance(self, ep: _Episode, change: int) -> _Motion:
+        """Set the ego's speed (or let SUMO drive it), simulate one step, read the outcome."""
         api = self._conn.api
-        cmd = ep.command
-        prev_obs = self._last_obs
-        prev_pos = ep.pos_m
-        baseline = self.config.ego_model != "agent"
         v_new = max(0.0, ep.speed_mps + change)
         try:
-            if baseline:
+            if self.config.ego_model != "agent":
                 # SUMO drives; STOP asks it to brake to a standstill within its decel limit.
-                api.vehicle.setSpeed(EGO_ID, 0.0 if cmd is Command.STOP else -1.0)
+                api.vehicle.setSpeed(EGO_ID, 0.0 if ep.command is Command.STOP else -1.0)
             else:
                 api.vehicle.setSpeed(EGO_ID, v_new)
             if ep.pedestrians is not None:
@@ -244,81 +301,77 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         sim = api.simulation.getSubscriptionResults()
         collided = bool(sim.get(tc.VAR_COLLIDING_VEHICLES_IDS)) and self._ego_collided()
         arrived = not collided and EGO_ID in sim.get(tc.VAR_ARRIVED_VEHICLES_IDS, ())
-        present = not collided and not arrived
-        ego = api.vehicle.getSubscriptionResults(EGO_ID) if present else None
+        ego = None
+        if not collided and not arrived:
+            ego = api.vehicle.getSubscriptionResults(EGO_ID)
         if ego is not None:
             v_new = float(ego[tc.VAR_SPEED])
             ep.pos_m = ep.start_pos_m + float(ego[tc.VAR_DISTANCE])
         else:
-            ep.pos_m = prev_pos + v_new * STEP_LENGTH_S
-        if baseline:
-            change = round(v_new - ep.speed_mps)
-        accel = v_new - ep.speed_mps
-        jerk = accel - ep.accel_mps2
-        red_run = self._ran_red_light(prev_pos, ep.pos_m)
-        ped_violation = self._violated_crossing(prev_pos, ep.pos_m)
-        legal_limit = self.geometry.limit_at(ep.pos_m)
-        speeding = v_new > legal_limit + 1e-6
-        ep.speed_mps, ep.accel_mps2 = v_new, accel
-        self._apply_schedule(ep.steps * STEP_LENGTH_S)
+            ep.pos_m += v_new * STEP_LENGTH_S
+        return _Motion(v_new, collided, arrived, ego)
 
-        if ego is not None:
-            obs, leader, real = self._observe(api, ego)
-        else:
-            obs, leader, real = prev_obs.copy(), None, None
-            obs[S.V_EGO] = v_new
-            obs[S.CMD] = float(ep.command)
-        gap = leader.gap_m if leader else math.inf
-        closing = (v_new - leader.speed_mps) if leader else 0.0
-        ttc = time_to_collision(gap, closing) if leader else math.inf
-        headway = time_headway(gap, leader.length_m, v_new) if leader else math.inf
+    def _next_observation(
+        self, motion: _Motion, prev_obs: NDArray[np.float32]
+    ) -> tuple[NDArray[np.float32], _Leader | None, _Leader | None]:
+        """Observation after the step with its effective and real leaders; once the ego has
+        left the simulation, the previous observation with the new speed and command."""
+        if motion.ego is not None:
+            return self._observe(self._conn.api, motion.ego)
+        obs = prev_obs.copy()
+        obs[S.V_EGO] = motion.speed_mps
+        obs[S.CMD] = float(self._episode().command)
+        return obs, None, None
+
+    @staticmethod
+    def _features(step: _Step) -> StepFeatures:
+        """What the reward needs, w.r.t. the effective (real or virtual) leader."""
+        leader, v = step.leader, step.motion.speed_mps
         stop_reason: str | None = None
-        if leader is not None and gap <= STOP_REASON_GAP_M:
+        if leader is not None and leader.gap_m <= STOP_REASON_GAP_M:
             stop_reason = "signal" if leader.virtual else "queue"
-        features = StepFeatures(
-            speed_mps=v_new,
-            speed_change_mps=change,
-            limit_mps=float(prev_obs[S.V_LIM]),
-            ttc_s=ttc,
-            headway_s=headway,
-            jerk_mps3=jerk,
-            violation=red_run or ped_violation,
+        return StepFeatures(
+            speed_mps=v,
+            speed_change_mps=step.change,
+            limit_mps=step.limit_mps,
+            ttc_s=step.ttc_s,
+            headway_s=time_headway(leader.gap_m, leader.length_m, v) if leader else math.inf,
+            jerk_mps3=step.jerk,
+            violation=step.red_run or step.ped_violation,
             stop_reason=stop_reason,
-            collided=collided,
+            collided=step.motion.collided,
         )
-        terms = reward_terms(cmd, features)
-        terminated = collided or arrived
-        truncated = not terminated and ep.steps >= self.config.max_steps
-        ep.done = terminated or truncated
-        self._last_obs = obs
-        info = {
-            "command": cmd.label,
+
+    def _info(self, step: _Step, terms: RewardTerms) -> dict[str, Any]:
+        """The step's ``info``: command, kinematics, leaders, safety events, reward terms."""
+        ep = self._episode()
+        v, leader, real = step.motion.speed_mps, step.leader, step.real
+        legal_limit = self.geometry.limit_at(ep.pos_m)
+        return {
+            "command": step.command.label,
             "next_command": ep.command.label,
             "time_s": ep.steps * STEP_LENGTH_S,
-            "speed_mps": v_new,
-            "speed_change_mps": change,
-            "accel_mps2": accel,
-            "jerk_mps3": jerk,
+            "speed_mps": v,
+            "speed_change_mps": step.change,
+            "accel_mps2": step.accel,
+            "jerk_mps3": step.jerk,
             "limit_mps": legal_limit,
-            "posted_limit_mps": float(prev_obs[S.V_LIM]),
-            "gap_m": gap,
+            "posted_limit_mps": step.limit_mps,
+            "gap_m": leader.gap_m if leader else math.inf,
             "leader_virtual": bool(leader.virtual) if leader else False,
-            "ttc_s": ttc,
-            "headway_s": headway,
+            "ttc_s": step.ttc_s,
+            "headway_s": time_headway(leader.gap_m, leader.length_m, v) if leader else math.inf,
             "real_gap_m": real.gap_m if real else math.inf,
-            "real_ttc_s": time_to_collision(real.gap_m, v_new - real.speed_mps)
-            if real
-            else math.inf,
-            "real_headway_s": time_headway(real.gap_m, real.length_m, v_new) if real else math.inf,
+            "real_ttc_s": time_to_collision(real.gap_m, v - real.speed_mps) if real else math.inf,
+            "real_headway_s": time_headway(real.gap_m, real.length_m, v) if real else math.inf,
             "distance_m": ep.pos_m - ep.start_pos_m,
-            "collision": collided,
-            "red_light_run": red_run,
-            "ped_violation": ped_violation,
-            "speeding": speeding,
-            "arrived": arrived,
+            "collision": step.motion.collided,
+            "red_light_run": step.red_run,
+            "ped_violation": step.ped_violation,
+            "speeding": v > legal_limit + 1e-6,
+            "arrived": step.motion.arrived,
             "reward_terms": terms.as_dict(),
         }
-        return self._output(obs), terms.total, terminated, truncated, info
 
     def close(self) -> None:
         """Stop SUMO (idempotent)."""
