@@ -19,8 +19,10 @@ import pytest
 from explaindrive.agent.checkpoint import CheckpointError, load_checkpoint
 from explaindrive.agent.config import SEED_POOL_BASE, TrainConfig, preset
 from explaindrive.agent.controller import QPolicy
+from explaindrive.agent.rollout import NStepQueue
+from explaindrive.agent.run_log import moving_average
 from explaindrive.agent.schedule import plan_episode
-from explaindrive.agent.trainer import NStepQueue, moving_average, train
+from explaindrive.agent.trainer import train
 from tests.agent.fake_drive_env import FakeDriveEnv
 
 EPISODE_STEPS = 20

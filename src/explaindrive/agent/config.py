@@ -105,6 +105,8 @@ class TrainConfig:
     seed_pool: int | None = None
     """If set, episode seeds are drawn from this many values (``SEED_POOL_BASE`` onwards), so
     the env's cached warm-up states are reused; ``None`` gives every episode a fresh seed."""
+    rollout_steps: int = 16
+    """Env steps each worker plays per round; the workers get new weights every round."""
     max_episode_steps: int | None = None
     """Env step limit per episode; ``None`` keeps the env's default."""
     safe_learning: bool = False
@@ -197,7 +199,7 @@ def _problems(c: TrainConfig) -> typing.Iterator[str]:
     positive = (
         "episodes", "lr_decay_steps", "buffer_size", "batch_size", "train_frequency",
         "target_update_interval", "eps_decay_steps", "checkpoint_every_episodes",
-        "log_every_updates", "torch_threads", "moving_average_window", "n_step",
+        "log_every_updates", "torch_threads", "moving_average_window", "n_step", "rollout_steps",
     )  # fmt: skip
     for name in positive:
         if getattr(c, name) <= 0:

@@ -18,7 +18,9 @@ from explaindrive.agent.config import (
     load_config_file,
     parse_override,
 )
+from explaindrive.agent.ray_pool import require_ray
 from explaindrive.cli._errors import error_line
+from explaindrive.cli._grid_options import check_ray_target
 
 console = Console()
 
@@ -96,18 +98,43 @@ def train_command(
     progress: Annotated[
         bool, typer.Option("--progress/--no-progress", help="Show a progress bar.")
     ] = True,
+    ray: Annotated[
+        bool, typer.Option("--ray", help="Run the env workers as actors on a local Ray.")
+    ] = False,
+    ray_address: Annotated[
+        str | None,
+        typer.Option("--ray-address", help="Run the env workers on this Ray cluster."),
+    ] = None,
+    seeds: Annotated[
+        str | None,
+        typer.Option(
+            "--seeds",
+            help="Train one run per seed side by side (e.g. 0,1,2), then evaluate each "
+            "on the same grid (see docs/agent.md).",
+        ),
+    ] = None,
 ) -> None:
     """Train a D3QN driving agent with the paper's command schedule."""
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.trainer import Trainer
 
+    if seeds is not None:
+        run_args = seed_run_args(mode, episodes, envs, resume, preset, config_file,
+                                 overrides or [], ray, ray_address)  # fmt: skip
+        _train_seeds(mode, seeds, seed, out, run_args)
+        return
     out = out or Path("runs") / mode
     try:
+        if (problem := check_ray_target(ray, ray_address)) is not None:
+            raise ConfigError(problem)
+        if ray or ray_address:
+            require_ray()
         config = resolve_config(
             mode.strip().lower(), preset, config_file, overrides or [], out, resume,
             episodes=episodes, num_envs=envs, seed=seed,
         )  # fmt: skip
-        trainer = Trainer(config, out, resume=resume, show_progress=progress)
+        trainer = Trainer(config, out, resume=resume, show_progress=progress, use_ray=ray,
+                          ray_address=ray_address)  # fmt: skip
     except (ConfigError, CheckpointError) as exc:
         console.print(error_line(exc))
         raise typer.Exit(2) from None
@@ -128,6 +155,63 @@ def train_command(
     ):
         table.add_row(key, str(value))
     console.print(table)
+
+
+def seed_run_args(
+    mode: str,
+    episodes: int | None,
+    envs: int | None,
+    resume: bool,
+    preset: str | None,
+    config_file: Path | None,
+    overrides: list[str],
+    ray: bool,
+    ray_address: str | None,
+) -> list[str]:
+    """The ``train`` options every run of ``--seeds`` gets (its seed and folder are added)."""
+    args = ["--mode", mode]
+    for flag, value in (("--episodes", episodes), ("--envs", envs), ("--preset", preset),
+                        ("--config", config_file), ("--ray-address", ray_address)):  # fmt: skip
+        if value is not None:
+            args += [flag, str(value)]
+    for item in overrides:
+        args += ["--set", item]
+    args += ["--resume"] if resume else []
+    args += ["--ray"] if ray else []
+    return args
+
+
+def _train_seeds(
+    mode: str, seeds_text: str, seed: int | None, out: Path | None, train_args: list[str]
+) -> None:
+    """``--seeds``: one run per seed, then the combined table (:mod:`explaindrive.agent.sweep`)."""
+    from explaindrive.agent.sweep import (
+        DEFAULT_EVAL_SEEDS,
+        DEFAULT_EVAL_STOPS,
+        evaluate_seeds,
+        train_seeds,
+    )
+    from explaindrive.evaluation.paper import PAPER_TRAFFIC_LEVELS
+    from explaindrive.evaluation.spec import SpecError, parse_seeds
+
+    try:
+        if seed is not None:
+            raise ConfigError("give --seed or --seeds, not both")
+        seeds = parse_seeds(seeds_text)
+    except (ConfigError, SpecError) as exc:
+        console.print(error_line(exc))
+        raise typer.Exit(2) from None
+    out = out or Path("runs") / f"{mode}-seeds"
+    console.print(f"training {mode} with seeds {', '.join(map(str, seeds))} side by side -> {out}")
+    codes = train_seeds(train_args, seeds, out)
+    for s, code in codes.items():
+        status = "done" if code == 0 else f"failed (exit {code}, see {out}/seed-{s}.log)"
+        console.print(f"seed {s}: {status}")
+    results = evaluate_seeds(out, seeds, parse_seeds(DEFAULT_EVAL_SEEDS), PAPER_TRAFFIC_LEVELS,
+                             DEFAULT_EVAL_STOPS)  # fmt: skip
+    console.print((out / "seeds.md").read_text(encoding="utf-8"), markup=False)
+    if not results or any(code != 0 for code in codes.values()):
+        raise typer.Exit(1)
 
 
 def register(app: typer.Typer) -> None:

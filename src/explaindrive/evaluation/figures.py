@@ -140,7 +140,7 @@ def plot_training_curves(runs: Mapping[str, Path], path: Path, window: int = 50)
     Raises:
         ValueError: if ``runs`` is empty or a CSV has no ``return`` column.
     """
-    from explaindrive.agent.trainer import moving_average
+    from explaindrive.agent.run_log import moving_average
 
     if not runs:
         raise ValueError("plot_training_curves needs at least one run")

@@ -1,0 +1,127 @@
+"""Rollout workers as Ray actors: ``explaindrive train --ray [--ray-address ADDR]``.
+
+Each actor holds one :class:`~explaindrive.agent.rollout.RolloutWorker` (one SUMO
+simulation, as libsumo requires); the learner stays on the driver. The weights of a round go
+into the object store once and every actor reads them from there. An actor that dies is
+restarted by Ray (``max_restarts=-1``); the round it was playing comes back as
+:class:`~explaindrive.agent.workers.WorkerLost`. Ray is the optional extra
+``explaindrive[ray]``.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import replace
+from types import ModuleType
+from typing import Any
+
+from explaindrive.agent.config import ConfigError, TrainConfig
+from explaindrive.agent.rollout import CollectRequest, EnvFactory, Rollout, RolloutWorker
+from explaindrive.agent.workers import RoundResult, WorkerLost
+
+log = logging.getLogger(__name__)
+
+RAY_MISSING = "--ray needs Ray, which is not installed: pip install 'explaindrive[ray]'"
+
+
+def require_ray() -> ModuleType:
+    """The ``ray`` module.
+
+    Raises:
+        ConfigError: naming the extra, if Ray is not installed.
+    """
+    try:
+        import ray
+    except ImportError:
+        raise ConfigError(RAY_MISSING) from None
+    return ray
+
+
+class RayRolloutActor:
+    """The body of a Ray actor: a rollout worker that also reports its process id."""
+
+    def __init__(self, config: TrainConfig, env_factory: EnvFactory, worker_id: int) -> None:
+        self.worker = RolloutWorker(config, env_factory, worker_id)
+
+    def collect(self, request: CollectRequest, weights: Any = None) -> Rollout:
+        """Play one round; ``weights`` (resolved from the object store) replace the request's."""
+        if weights is not None:
+            request = replace(request, weights=weights)
+        return self.worker.collect(request)
+
+    def pid(self) -> int:
+        """The actor's process id."""
+        return os.getpid()
+
+
+class RayPool:
+    """``num_workers`` rollout actors on a local Ray or on the cluster at ``address``."""
+
+    def __init__(
+        self,
+        config: TrainConfig,
+        env_factory: EnvFactory,
+        num_workers: int,
+        address: str | None = None,
+    ) -> None:
+        self.ray = ray = require_ray()
+        self.num_workers = num_workers
+        self._owns_ray = not ray.is_initialized()
+        if self._owns_ray:
+            if address:
+                ray.init(address=address, include_dashboard=False, log_to_driver=False)
+            else:
+                cpus = max(num_workers, os.cpu_count() or 1)
+                ray.init(num_cpus=cpus, include_dashboard=False, log_to_driver=False)
+        actor = ray.remote(num_cpus=1, max_restarts=-1, max_task_retries=0)(RayRolloutActor)
+        self.actors = [actor.remote(config, env_factory, i) for i in range(num_workers)]
+        self._refs: list[Any] = []
+
+    def submit(self, requests: Sequence[CollectRequest]) -> None:
+        """See :meth:`~explaindrive.agent.workers.WorkerPool.submit`."""
+        weights = next((r.weights for r in requests if r.weights is not None), None)
+        shared = self.ray.put(weights) if weights is not None else None
+        self._refs = [
+            actor.collect.remote(
+                replace(r, weights=None), shared if r.weights is not None else None
+            )
+            for actor, r in zip(self.actors, requests, strict=True)
+        ]
+
+    def gather(self) -> list[RoundResult]:
+        """See :meth:`~explaindrive.agent.workers.WorkerPool.gather`."""
+        out: list[RoundResult] = []
+        for i, ref in enumerate(self._refs):
+            try:
+                out.append(self.ray.get(ref))
+            except self.ray.exceptions.RayActorError as exc:
+                out.append(WorkerLost(i, type(exc).__name__))
+                self._await_restart(i)
+        return out
+
+    def _await_restart(self, i: int, timeout_s: float = 120.0) -> None:
+        """Wait until Ray has restarted actor ``i`` (its next round would fail before)."""
+        deadline = time.monotonic() + timeout_s
+        while True:
+            try:
+                self.ray.get(self.actors[i].pid.remote(), timeout=timeout_s)
+                return
+            except self.ray.exceptions.RayActorError:
+                if time.monotonic() > deadline:
+                    msg = f"Ray did not restart worker {i} within {timeout_s:.0f} s"
+                    raise RuntimeError(msg) from None
+                time.sleep(0.5)
+
+    def pids(self) -> list[int]:
+        """Process ids of the actors (tests kill one)."""
+        return [int(pid) for pid in self.ray.get([a.pid.remote() for a in self.actors])]
+
+    def close(self) -> None:
+        """Stop the actors, and Ray if this pool started it."""
+        for actor in self.actors:
+            self.ray.kill(actor)
+        if self._owns_ray:
+            self.ray.shutdown()

@@ -1,0 +1,152 @@
+"""What a training run writes as it goes: ``episodes.csv``, TensorBoard scalars, a progress
+bar, and the training-curve figure at the end."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from explaindrive.agent.rollout import EpisodeSummary
+
+CSV_FIELDS: tuple[str, ...] = (
+    "episode", "env", "seed", "traffic_level", "stops", "return", "length", "env_steps",
+    "epsilon", "collision", "red_light_run", "ped_violation", "speeding_steps",
+    "shield_share", "shielded", "mean_speed_mps", "distance_m", "terminated", "truncated",
+    "wall_time_s",
+)  # fmt: skip
+
+
+def csv_row(
+    ep: EpisodeSummary, worker: int, env_steps: int, epsilon: float, wall_time_s: float
+) -> dict[str, Any]:
+    """The ``episodes.csv`` row of a finished episode."""
+    return {
+        "episode": ep.index, "env": worker, "seed": ep.seed, "traffic_level": ep.traffic_level,
+        "stops": int(ep.stops), "return": round(ep.ret, 4), "length": ep.length,
+        "env_steps": env_steps, "epsilon": round(epsilon, 5),
+        **{k: int(v) for k, v in ep.flags.items()}, "speeding_steps": ep.speeding_steps,
+        "shield_share": round(ep.shield_share, 5), "shielded": int(ep.shielded),
+        "mean_speed_mps": round(ep.mean_speed_mps, 4), "distance_m": round(ep.distance_m, 2),
+        "terminated": int(ep.terminated), "truncated": int(not ep.terminated),
+        "wall_time_s": round(wall_time_s, 2),
+    }  # fmt: skip
+
+
+def tb_episode(tb: Any, ep: EpisodeSummary, step: int, epsilon: float, sps: float) -> None:
+    """The episode's TensorBoard scalars at env step ``step``."""
+    tb.add_scalar("charts/episodic_return", ep.ret, step)
+    tb.add_scalar("charts/episodic_length", ep.length, step)
+    tb.add_scalar("charts/epsilon", epsilon, step)
+    tb.add_scalar("charts/steps_per_second", sps, step)
+    tb.add_scalar("charts/mean_speed_mps", ep.mean_speed_mps, step)
+    for key, value in ep.flags.items():
+        tb.add_scalar(f"safety/{key}", float(value), step)
+    tb.add_scalar("safety/speeding_steps", ep.speeding_steps, step)
+    tb.add_scalar("safety/shield_share", ep.shield_share, step)
+
+
+def truncate_csv(path: Path, rows: int) -> bool:
+    """Keep the header and the first ``rows`` episodes; False if the file is missing."""
+    if not path.exists():
+        return False
+    with path.open(newline="") as f:
+        lines = list(csv.reader(f))
+    with path.open("w", newline="") as f:
+        csv.writer(f).writerows(lines[: rows + 1])
+    return True
+
+
+def moving_average(values: np.ndarray, window: int) -> np.ndarray:
+    """Trailing moving average; the first ``window - 1`` points average what exists so far."""
+    values = np.asarray(values, dtype=np.float64)
+    if window <= 0:
+        raise ValueError(f"window must be > 0, got {window}")
+    csum = np.cumsum(np.insert(values, 0, 0.0))
+    idx = np.arange(1, len(values) + 1)
+    lo = np.maximum(idx - window, 0)
+    return (csum[idx] - csum[lo]) / (idx - lo)
+
+
+def plot_training_curve(csv_path: Path, png_path: Path, window: int = 50, title: str = "") -> Path:
+    """The paper's training-curve figure: episode reward and its ``window``-episode average."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with csv_path.open(newline="") as f:
+        returns = np.array([float(row["return"]) for row in csv.DictReader(f)])
+    fig, ax = plt.subplots(figsize=(7, 4))
+    x = np.arange(1, len(returns) + 1)
+    ax.plot(x, returns, color="tab:blue", alpha=0.3, linewidth=0.8, label="episode reward")
+    if len(returns):
+        ax.plot(
+            x, moving_average(returns, window), color="tab:blue", label=f"{window}-episode mean"
+        )
+    ax.set_xlabel("episode")
+    ax.set_ylabel("total reward")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    png_path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(png_path, dpi=120)
+    plt.close(fig)
+    return png_path
+
+
+def git_commit() -> str | None:
+    """Commit of the source tree, if it is a git checkout."""
+    try:
+        out = subprocess.run(
+            ["git", "rev-parse", "HEAD"],
+            cwd=Path(__file__).resolve().parent,
+            capture_output=True,
+            text=True,
+            timeout=5,
+            check=True,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None
+
+
+class Progress:
+    """Rich progress bar (or nothing) showing episode, reward, epsilon and steps/s."""
+
+    def __init__(self, enabled: bool, total: int, done: int, title: str) -> None:
+        self._progress = None
+        if not enabled:
+            return
+        from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn
+        from rich.progress import Progress as RichProgress
+
+        self._progress = RichProgress(
+            TextColumn("[bold]{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("reward {task.fields[reward]:>8.1f} (avg {task.fields[avg]:>8.1f})"),
+            TextColumn("eps {task.fields[eps]:.3f}"),
+            TextColumn("{task.fields[sps]:>6.0f} steps/s"),
+            TimeElapsedColumn(),
+        )
+        self._task = self._progress.add_task(
+            title, total=total, completed=done, reward=0.0, avg=0.0, eps=1.0, sps=0.0
+        )
+        self._progress.start()
+
+    def update(self, done: int, reward: float, avg: float, eps: float, sps: float) -> None:
+        """Show the latest figures."""
+        if self._progress is not None:
+            self._progress.update(
+                self._task, completed=done, reward=reward, avg=avg, eps=eps, sps=sps
+            )
+
+    def close(self) -> None:
+        """Remove the bar."""
+        if self._progress is not None:
+            self._progress.stop()

@@ -1,0 +1,70 @@
+"""Rollout workers and their local pools."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+import torch
+
+from explaindrive.agent.config import preset
+from explaindrive.agent.network import DuelingQNetwork
+from explaindrive.agent.rollout import CollectRequest, RolloutWorker
+from explaindrive.agent.workers import InProcessPool, ProcessPool, make_pool
+from tests.agent.fake_drive_env import FakeDriveEnv
+
+CONFIG = preset("safe").replace(hidden_sizes=[8], n_step=3, num_envs=2, episodes=10)
+FACTORY = functools.partial(FakeDriveEnv, max_steps=5)
+
+
+def _broken_env() -> FakeDriveEnv:
+    raise OSError("no SUMO here")
+
+
+def _weights() -> dict[str, torch.Tensor]:
+    torch.manual_seed(0)
+    return DuelingQNetwork((8,)).state_dict()
+
+
+def test_a_worker_plays_its_reserved_episode_and_ships_n_step_transitions() -> None:
+    worker = RolloutWorker(CONFIG, FACTORY, 0)
+    first = worker.collect(CollectRequest(steps=3, epsilon=0.5, weights=_weights(), start=4))
+    assert (first.steps, first.started, first.running, first.episodes) == (3, True, 4, [])
+    assert len(first.transitions) == 1  # 3 steps complete one 3-step transition
+    # two more steps end the 5-step episode; no new one is reserved, so the round stops
+    second = worker.collect(CollectRequest(steps=10, epsilon=0.5))
+    assert (second.steps, second.started, second.running) == (2, False, None)
+    assert len(second.transitions) == 4  # the episode's remaining 4 transitions
+    (episode,) = second.episodes
+    assert (episode.index, episode.length, episode.ended_at_step) == (4, 5, 2)
+    assert not episode.terminated  # the fake road truncates at 5 steps
+    *_, terminated, discount, mask, next_mask = second.transitions[-1]
+    assert discount == pytest.approx(CONFIG.gamma) and not terminated
+    assert mask.shape == next_mask.shape == (7,)
+    idle = worker.collect(CollectRequest(steps=10, epsilon=0.5))
+    assert (idle.steps, idle.transitions) == (0, [])
+
+
+def test_local_processes_play_exactly_what_in_process_workers_play() -> None:
+    requests = [CollectRequest(7, 0.3, _weights(), start) for start in (0, 1)]
+    results = []
+    for pool in (InProcessPool(CONFIG, FACTORY, 2), ProcessPool(CONFIG, FACTORY, 2)):
+        try:
+            pool.submit(requests)
+            results.append(pool.gather())
+        finally:
+            pool.close()
+    for a, b in zip(*results, strict=True):
+        assert (a.steps, a.running) == (b.steps, b.running)
+        assert [ep.ret for ep in a.episodes] == [ep.ret for ep in b.episodes]
+        for ta, tb in zip(a.transitions, b.transitions, strict=True):
+            assert all(np.array_equal(x, y) for x, y in zip(ta, tb, strict=True))
+
+
+def test_worker_errors_name_the_worker() -> None:
+    with pytest.raises(RuntimeError, match=r"env worker 0 failed:[\s\S]*no SUMO here"):
+        ProcessPool(CONFIG, _broken_env, 1)
+    with pytest.raises(ValueError, match="num_workers must be > 0"):
+        make_pool(CONFIG, FACTORY, 0)
+    assert isinstance(make_pool(CONFIG, FACTORY, 1), InProcessPool)
