@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import io
 import time
+import wave
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
+import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
@@ -19,17 +22,43 @@ from explaindrive.web import create_app
 from ..ride.fakes import ScriptedController, fake_language
 
 STEP_PERIOD_S = 0.05  # [s] twenty control steps per second of wall time
+TEST_HOST = "testserver"  # the Host header of Starlette's test client
+TEST_ORIGIN = f"http://{TEST_HOST}"
+
+
+def wav(seconds: float, amplitude: int = 8000, rate_hz: int = 16_000, channels: int = 1) -> bytes:
+    """A WAV file of a 440 Hz tone (``amplitude`` 0 gives silence)."""
+    t = np.arange(int(seconds * rate_hz)) / rate_hz
+    tone = (amplitude * np.sin(2 * np.pi * 440.0 * t)).astype("<i2")
+    buffer = io.BytesIO()
+    with wave.open(buffer, "wb") as out:
+        out.setnchannels(channels)
+        out.setsampwidth(2)
+        out.setframerate(rate_hz)
+        out.writeframes(np.repeat(tone, channels).tobytes())
+    return buffer.getvalue()
 
 
 class UploadTranscriber:
-    """Stands in for Whisper: a WAV upload 'says' it is in a hurry, anything else is silence."""
+    """Stands in for Whisper: a loud recording 'says' it is in a hurry, a quiet one nothing.
+
+    The files it was given are listed in ``seen`` (name, size in bytes, duration in s).
+    """
+
+    seen: ClassVar[list[tuple[str, int, float]]] = []
 
     def load(self) -> None:
         pass
 
     def transcribe(self, path: str | Path) -> Transcript:
-        text = "please hurry" if Path(path).read_bytes()[:4] == b"RIFF" else ""
-        return Transcript(text, 1.0, 0.0, "en")
+        with wave.open(str(path), "rb") as audio:
+            rate, frames = audio.getframerate(), audio.readframes(audio.getnframes())
+        samples = np.frombuffer(frames, dtype="<i2")
+        UploadTranscriber.seen.append(
+            (Path(path).name, Path(path).stat().st_size, samples.size / rate)
+        )
+        loud = samples.size > 0 and int(np.abs(samples).max()) > 1000
+        return Transcript("please hurry" if loud else "", samples.size / rate, 0.0, "en")
 
 
 def fake_session_factory(config: RideConfig) -> RideSession:
@@ -40,7 +69,13 @@ def fake_session_factory(config: RideConfig) -> RideSession:
 
 @pytest.fixture
 def client() -> Iterator[TestClient]:
-    app = create_app(fake_session_factory, step_period_s=STEP_PERIOD_S, max_upload_bytes=64_000)
+    UploadTranscriber.seen.clear()
+    app = create_app(
+        fake_session_factory,
+        step_period_s=STEP_PERIOD_S,
+        max_upload_bytes=64_000,
+        hosts=(TEST_HOST,),
+    )
     with TestClient(app) as c:
         yield c
 

@@ -10,9 +10,18 @@ from fastapi.testclient import TestClient
 from explaindrive.ride.config import RideConfig
 from explaindrive.web import RealStack, create_app
 
-from .conftest import STEP_PERIOD_S, fake_session_factory, wait_for, wait_status
+from .conftest import (
+    STEP_PERIOD_S,
+    UploadTranscriber,
+    fake_session_factory,
+    wait_for,
+    wait_status,
+    wav,
+)
+from .flac import flac_bomb
 
-WAV = b"RIFF\x24\x00\x00\x00WAVEfmt " + bytes(28)
+WAV = wav(1.0)
+HEADER_ONLY_WAV = b"RIFF\x24\x00\x00\x00WAVEfmt " + bytes(28)
 START = {"traffic_level": 0.5, "seed": 3, "max_steps": 300}
 
 
@@ -152,12 +161,9 @@ def test_a_ride_through_the_api(client):
             assert nxt["t"] > snap["history"][-1]["t"] - 1
         assert manager.listener_count == 1
 
-        # a spoken line: stored under a server-chosen name, then transcribed
+        # a spoken line: decoded, stored under a server-chosen name, transcribed, deleted
         res = client.post("/api/ride/audio", files={"file": ("../../etc/passwd", WAV, "audio/wav")})
         assert res.status_code == 202 and res.json() == {"id": 2}
-        stored = list(manager.upload_dir.iterdir())
-        assert len(stored) == 1 and stored[0].suffix == ".wav"
-        assert stored[0].name.startswith("utterance-") and "passwd" not in stored[0].name
         heard = wait_for(
             ws.receive_json,
             lambda m: (
@@ -166,6 +172,10 @@ def test_a_ride_through_the_api(client):
         )
         transcript = next(e for e in heard["passenger"] if e["type"] == "transcript")
         assert transcript["text"] == "please hurry"
+        ((name, size, duration_s),) = UploadTranscriber.seen
+        assert name.startswith("utterance-") and name.endswith(".wav") and "passwd" not in name
+        assert (size, duration_s) == (44 + 2 * 16_000, 1.0)  # 1 s of 16 kHz 16-bit mono
+        assert list(manager.upload_dir.iterdir()) == []  # deleted once transcribed
         spoken = [e for m in [heard] for e in m["passenger"] if e["type"] == "line"]
         assert all(e["audio"] in (None, "uploaded recording") for e in spoken)  # no server paths
         wait_for(ws.receive_json, lambda m: m["type"] == "frame" and m["question"])
@@ -181,7 +191,6 @@ def test_a_ride_through_the_api(client):
         res = client.post("/api/ride/reset")
         assert res.status_code == 200 and res.json()["state"] == "idle"
         wait_for(ws.receive_json, lambda m: m["type"] == "status" and m["state"] == "idle")
-        assert list(manager.upload_dir.iterdir()) == []  # uploads go with their ride
         assert client.post("/api/ride/say", json={"text": "hurry"}).status_code == 409
 
 
@@ -191,7 +200,11 @@ def test_a_ride_through_the_api(client):
         ({"file": ("a.txt", b"hello", "text/plain")}, 415, "unsupported content type"),
         ({"file": ("a.wav", b"OggS" + bytes(40), "audio/wav")}, 415, "a ogg file"),
         ({"file": ("a.wav", b"", "audio/wav")}, 422, "empty"),
-        ({"file": ("a.wav", WAV + bytes(70_000), "audio/wav")}, 413, "exceeds"),
+        ({"file": ("a.wav", WAV + bytes(40_000), "audio/wav")}, 413, "upload exceeds 64000 bytes"),
+        ({"file": ("a.wav", WAV + bytes(60_000), "audio/wav")}, 413, "body exceeds 80384 bytes"),
+        ({"file": ("a.wav", HEADER_ONLY_WAV, "audio/wav")}, 415, "cannot be decoded"),
+        ({"file": ("a.flac", flac_bomb(60), "audio/flac")}, 413, "longer than 30 s"),
+        ({"file": ("a.wav", wav(31.0, rate_hz=1000), "audio/wav")}, 413, "longer than 30 s"),
         ({"audio": ("a.wav", WAV, "audio/wav")}, 422, "multipart field 'file'"),
         ([("file", ("a.wav", WAV, "audio/wav"))] * 2, 400, "unreadable upload"),
         (None, 422, "multipart field 'file'"),
@@ -239,7 +252,8 @@ def test_a_ride_that_cannot_start():
             raise FileNotFoundError("policy fast.pt not found")
         return fake_session_factory(config)
 
-    with TestClient(create_app(broken, step_period_s=STEP_PERIOD_S)) as client:
+    app = create_app(broken, step_period_s=STEP_PERIOD_S)  # answers the loopback names
+    with TestClient(app, base_url="http://127.0.0.1:8000") as client:
         res = client.post("/api/ride/start", json=START)
         assert res.status_code == 503 and "policy fast.pt not found" in res.json()["detail"]
         status = client.get("/api/status").json()

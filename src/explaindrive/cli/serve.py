@@ -5,7 +5,7 @@ from __future__ import annotations
 import typer
 from rich.console import Console
 
-from explaindrive.cli._errors import error_line
+from explaindrive.cli._errors import print_error
 from explaindrive.cli._language_common import ENCODER_HELP
 from explaindrive.language.backends import check_backend
 from explaindrive.language.encoders import DEFAULT_ENCODER, check_installed
@@ -29,23 +29,31 @@ def serve(
         max=10.0,
         help="Seconds of wall time per 1 s control step (1 = real time).",
     ),
+    allow_host: list[str] = typer.Option(
+        [],
+        "--allow-host",
+        help="Another name the page is opened under (repeatable; e.g. the machine's LAN name).",
+    ),
 ) -> None:
     """Serve the passenger page: watch the ride, talk to the car, read its explanations."""
     import uvicorn
 
     from explaindrive.web import create_app
+    from explaindrive.web.guard import LOOPBACK_HOSTS, served_hosts
 
     try:  # before the server starts
         check_backend(backend)
         check_installed(encoder)
     except (FileNotFoundError, ValueError) as exc:
-        console.print(error_line(exc))
+        print_error(console, exc)
         raise typer.Exit(2) from exc
-    if host not in ("127.0.0.1", "localhost", "::1"):
+    hosts = served_hosts(host, allow_host)
+    if host not in LOOPBACK_HOSTS:
         console.print(
             f"[yellow]warning:[/yellow] binding {host} exposes the ride controls to the network"
         )
-    app = create_app(backend=backend, encoder=encoder, step_period_s=step_period)
+    console.print(f"answering Host names: {', '.join(sorted(hosts))}", highlight=False)
+    app = create_app(backend=backend, encoder=encoder, step_period_s=step_period, hosts=hosts)
     console.print(f"passenger page: http://{host}:{port}/  (Ctrl+C to stop)")
     uvicorn.run(app, host=host, port=port, log_level="warning")
 

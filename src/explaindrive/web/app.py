@@ -10,6 +10,10 @@ Endpoints (all JSON unless noted):
 - ``POST /api/ride/audio`` (multipart, field ``file``): a recorded passenger line.
 - ``POST /api/ride/answer`` (:class:`AnswerRequest`): yes/no to the question.
 - ``WS /ws``: a snapshot, then a frame per step and a status message per change.
+
+Every request passes :class:`~explaindrive.web.guard.RequestGuard` first (``Host``,
+``Origin`` and body-size checks). There are no interactive API docs (``/docs``): the
+page works offline and Swagger would come from a CDN; ``/openapi.json`` describes the API.
 """
 
 from __future__ import annotations
@@ -17,23 +21,33 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
-from collections.abc import AsyncIterator, Awaitable, Callable
+from collections.abc import AsyncIterator, Awaitable, Callable, Iterable
 from contextlib import asynccontextmanager
 from pathlib import Path
 from typing import Any
 
 from fastapi import FastAPI, HTTPException, Request, WebSocket, WebSocketDisconnect
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from starlette.datastructures import UploadFile
+from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from explaindrive.language.backends import check_backend
 from explaindrive.language.encoders import DEFAULT_ENCODER, check_encoder
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.sim.scenario.files import default_scenario
-from explaindrive.web.audio import AudioRejectedError, read_upload
+from explaindrive.web.audio import (
+    MAX_AUDIO_S,
+    AudioRejectedError,
+    decode_bounded,
+    read_upload,
+    wav_bytes,
+)
+from explaindrive.web.guard import LOOPBACK_HOSTS, RequestGuard
 from explaindrive.web.manager import (
+    RideBusyError,
     RideConflictError,
     RideManager,
     RideStartError,
@@ -46,6 +60,10 @@ log = logging.getLogger(__name__)
 
 STATIC_DIR = Path(__file__).parent / "static"
 MAX_UPLOAD_BYTES = 5 * 1024 * 1024  # [B] about five minutes of Opus, 50 s of 16-bit WAV
+MAX_JSON_BYTES = 16 * 1024  # [B] request bodies other than uploads (a request is 300 chars)
+MULTIPART_OVERHEAD_BYTES = 16 * 1024  # [B] boundaries and part headers around an upload
+MAX_DETAIL_ERRORS = 10  # validation errors listed in a 422 answer
+MAX_DETAIL_CHARS = 200  # characters of each message or location part in an error answer
 WS_QUEUE_FRAMES = 64  # frames a slow page may lag before it is resynchronised
 
 
@@ -89,6 +107,8 @@ def create_app(
     encoder: str = DEFAULT_ENCODER,
     step_period_s: float = 1.0,
     max_upload_bytes: int = MAX_UPLOAD_BYTES,
+    max_audio_s: float = MAX_AUDIO_S,
+    hosts: Iterable[str] = LOOPBACK_HOSTS,
 ) -> FastAPI:
     """Build the web app.
 
@@ -99,6 +119,9 @@ def create_app(
         encoder: LLM-1 sentence encoder of the default factory's embedded backend.
         step_period_s: wall time per 1 s control step [s]; 1.0 rides in real time.
         max_upload_bytes: largest accepted audio upload [B].
+        max_audio_s: longest accepted recording, counted while it is decoded [s].
+        hosts: the host names the server answers to (``Host`` header); the loopback
+            names by default (see :func:`explaindrive.web.guard.served_hosts`).
     """
     factory = session_factory or RealStack(backend, encoder)
     scene = load_scene(default_scenario().net_file)
@@ -112,17 +135,71 @@ def create_app(
         finally:
             await asyncio.to_thread(manager.shutdown)
 
-    app = FastAPI(title="ExplainDrive passenger", lifespan=lifespan)
+    app = FastAPI(title="ExplainDrive passenger", lifespan=lifespan, docs_url=None, redoc_url=None)
     app.state.manager = manager
     app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
+    upload_limit = max_upload_bytes + MULTIPART_OVERHEAD_BYTES
+    app.add_middleware(
+        RequestGuard,
+        hosts=hosts,
+        body_limit=lambda path: upload_limit if path == "/api/ride/audio" else MAX_JSON_BYTES,
+    )
+    _add_error_handlers(app)
+    _add_read_routes(app, manager, scene)
+    _add_ride_routes(app, manager, max_upload_bytes, max_audio_s)
+    _add_stream_route(app, manager)
+    return app
+
+
+def _caller(manager: RideManager) -> Callable[..., Awaitable[Any]]:
+    """``call(name, *args)``: run a manager command; its errors become HTTP answers."""
 
     async def call(name: str, *args: Any) -> Any:
         try:
             return await asyncio.wrap_future(manager.submit(name, *args))
         except RideConflictError as exc:
             raise HTTPException(status_code=409, detail=str(exc)) from exc
+        except RideBusyError as exc:
+            raise HTTPException(status_code=429, detail=str(exc)) from exc
         except RideStartError as exc:
             raise HTTPException(status_code=503, detail=str(exc)) from exc
+
+    return call
+
+
+def _add_error_handlers(app: FastAPI) -> None:
+    """Short error answers: a 422 never echoes the input, a stopped worker is a 503."""
+
+    @app.exception_handler(RequestValidationError)
+    async def invalid(_: Request, exc: RequestValidationError) -> JSONResponse:
+        return JSONResponse(status_code=422, content={"detail": short_errors(exc.errors())})
+
+    @app.exception_handler(RuntimeError)
+    async def worker_down(_: Request, exc: RuntimeError) -> JSONResponse:
+        log.error("request failed: %s", exc)
+        return JSONResponse(status_code=503, content={"detail": str(exc)[:MAX_DETAIL_CHARS]})
+
+
+def short_errors(errors: Iterable[Any]) -> list[dict[str, Any]]:
+    """Validation errors as ``{loc, msg, type}``, without the offending input, cut short."""
+    out = []
+    for error in list(errors)[:MAX_DETAIL_ERRORS]:
+        loc = [
+            part if isinstance(part, int) else str(part)[:MAX_DETAIL_CHARS]
+            for part in error.get("loc", ())
+        ]
+        out.append(
+            {
+                "loc": loc[:8],
+                "msg": str(error.get("msg", ""))[:MAX_DETAIL_CHARS],
+                "type": str(error.get("type", ""))[:MAX_DETAIL_CHARS],
+            }
+        )
+    return out
+
+
+def _add_read_routes(app: FastAPI, manager: RideManager, scene: Any) -> None:
+    """The page, the scene and the status."""
 
     @app.get("/", include_in_schema=False)
     async def index() -> FileResponse:
@@ -131,12 +208,20 @@ def create_app(
     @app.get("/api/scene")
     async def get_scene() -> dict[str, Any]:
         """The road network the page draws."""
-        return scene.to_json()
+        result: dict[str, Any] = scene.to_json()
+        return result
 
     @app.get("/api/status")
     async def get_status() -> dict[str, Any]:
         """The ride's state."""
         return manager.status()
+
+
+def _add_ride_routes(
+    app: FastAPI, manager: RideManager, max_upload_bytes: int, max_audio_s: float
+) -> None:
+    """Start, pause, resume, reset, say, audio and answer."""
+    call = _caller(manager)
 
     @app.post("/api/ride/start")
     async def start(body: StartRequest) -> dict[str, Any]:
@@ -167,27 +252,13 @@ def create_app(
         """A recorded passenger line (multipart field ``file``); transcribed by Whisper."""
         if manager.status()["state"] not in ("running", "paused"):
             raise HTTPException(status_code=409, detail="no ride is running; start one")
-        length = request.headers.get("content-length")
-        if length is not None and length.isdigit() and int(length) > max_upload_bytes + 16_384:
-            raise HTTPException(
-                status_code=413, detail=f"the upload exceeds {max_upload_bytes} bytes"
-            )
+        data = await _read_recording(request, max_upload_bytes)
         try:
-            async with request.form(max_files=1, max_fields=0) as form:
-                upload = form.get("file")
-                if not isinstance(upload, UploadFile):
-                    raise HTTPException(
-                        status_code=422, detail="send the recording as multipart field 'file'"
-                    )
-                data, suffix = await read_upload(upload, max_upload_bytes)
+            samples = await asyncio.to_thread(decode_bounded, data, max_audio_s)
         except AudioRejectedError as exc:
             raise HTTPException(status_code=exc.status_code, detail=str(exc)) from exc
-        except HTTPException:
-            raise
-        except Exception as exc:  # malformed multipart bodies
-            raise HTTPException(status_code=400, detail=f"unreadable upload: {exc}") from exc
-        path = manager.new_upload_path(suffix)
-        path.write_bytes(data)
+        path = manager.new_upload_path(".wav")
+        path.write_bytes(wav_bytes(samples))
         try:
             result: dict[str, Any] = await call("audio", path)
         except HTTPException:
@@ -201,10 +272,32 @@ def create_app(
         result: dict[str, Any] = await call("answer", body.yes)
         return result
 
-    @app.exception_handler(RuntimeError)
-    async def worker_down(_: Request, exc: RuntimeError) -> JSONResponse:
-        log.error("request failed: %s", exc)
-        return JSONResponse(status_code=503, content={"detail": str(exc)})
+
+async def _read_recording(request: Request, max_upload_bytes: int) -> bytes:
+    """The bytes of the multipart field ``file``, checked for type, size and signature."""
+    try:
+        async with request.form(max_files=1, max_fields=0) as form:
+            upload = form.get("file")
+            if not isinstance(upload, UploadFile):
+                raise HTTPException(
+                    status_code=422, detail="send the recording as multipart field 'file'"
+                )
+            data, _ = await read_upload(upload, max_upload_bytes)
+            return data
+    except AudioRejectedError as exc:
+        raise HTTPException(status_code=exc.status_code, detail=str(exc)) from exc
+    except StarletteHTTPException as exc:
+        if exc.status_code in (413, 422):  # from the guard while streaming, or no 'file'
+            raise
+        detail = f"unreadable upload: {exc.detail}"[:MAX_DETAIL_CHARS]
+        raise HTTPException(status_code=400, detail=detail) from exc
+    except Exception as exc:  # malformed multipart bodies
+        detail = f"unreadable upload: {exc}"[:MAX_DETAIL_CHARS]
+        raise HTTPException(status_code=400, detail=detail) from exc
+
+
+def _add_stream_route(app: FastAPI, manager: RideManager) -> None:
+    """``/ws``: a snapshot of the ride, then every frame and status change."""
 
     @app.websocket("/ws")
     async def stream(websocket: WebSocket) -> None:
@@ -246,5 +339,3 @@ def create_app(
             for task in tasks:
                 with contextlib.suppress(asyncio.CancelledError, WebSocketDisconnect, Exception):
                     await task
-
-    return app

@@ -24,10 +24,12 @@ from typing import Any
 
 from explaindrive.commands import Command
 from explaindrive.jsonsafe import finite
+from explaindrive.redact import redact, redact_json
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession, StepRecord
 from explaindrive.web.models import StartRequest
 from explaindrive.web.scene import Scene, snapshot
+from explaindrive.web.uploads import UploadTracker, delete_uploads_after_use
 
 log = logging.getLogger(__name__)
 
@@ -38,6 +40,8 @@ LOG_LIMIT = 200  # passenger events kept for pages that join late
 EXPLANATION_SCAN_STEPS = 30  # explanations attach to earlier steps; look this far back
 INTERPRET_DEADLINE_S = 8.0  # [s] a paced ride never waits on language; Whisper on CPU is slow
 COMMAND_TIMEOUT_S = 300.0  # [s] the first start loads the models
+MAX_WAITING_UPLOADS = 4  # recordings stored and not yet transcribed
+UPLOAD_GRACE_S = 2.0  # [s] kept past the transcription deadline before a sweep deletes it
 
 
 class RideState(StrEnum):
@@ -59,6 +63,10 @@ class RideStartError(RuntimeError):
     """The ride could not be started (models, policies or SUMO; HTTP 503)."""
 
 
+class RideBusyError(RuntimeError):
+    """Too many recordings are waiting to be transcribed (HTTP 429)."""
+
+
 @dataclass
 class _Job:
     name: str
@@ -73,7 +81,7 @@ class RideManager:
         session_factory: builds a ride session from its settings (called on the worker).
         scene: the static road scene (signal heads are looked up each step).
         step_period_s: wall time between control steps [s]; 1.0 is real time.
-        upload_dir: where uploaded audio is kept until its ride ends (a fresh temporary
+        upload_dir: where uploaded audio is kept until it is transcribed (a fresh temporary
             directory when omitted).
     """
 
@@ -108,7 +116,7 @@ class RideManager:
         self._last_frame: dict[str, Any] | None = None
         self._question: str | None = None
         self._explained_steps: set[int] = set()
-        self._uploads: list[Path] = []
+        self._uploads = UploadTracker(RideConfig().audio_deadline_s + UPLOAD_GRACE_S)
         self._next_step = 0.0
 
     # ------------------------------------------------------------------ lifecycle
@@ -226,6 +234,8 @@ class RideManager:
         self._publish({"type": "status", **self.status()})
         try:
             session = self.session_factory(config)
+            delete_uploads_after_use(session, self.upload_dir)
+            self._uploads.max_age_s = config.audio_deadline_s + UPLOAD_GRACE_S
             self._session = session
             session.start(Command.parse(settings.command))
         except Exception as exc:
@@ -234,9 +244,9 @@ class RideManager:
             self._end_session()
             with self._lock:
                 self._state = RideState.FAILED
-                self._error = f"{type(exc).__name__}: {exc}"
+                self._error = redact(f"{type(exc).__name__}: {exc}")
             self._publish({"type": "status", **self.status()})
-            raise RideStartError(f"the ride could not start: {exc}") from exc
+            raise RideStartError(redact(f"the ride could not start: {exc}")) from exc
         self._next_step = time.monotonic()
         self._set_state(RideState.RUNNING)
         return self.status()
@@ -275,7 +285,11 @@ class RideManager:
 
     def _do_audio(self, path: Path) -> dict[str, Any]:
         session = self._active_session()
-        self._uploads.append(path)
+        if self._uploads.waiting() >= MAX_WAITING_UPLOADS:
+            raise RideBusyError(
+                f"{MAX_WAITING_UPLOADS} recordings are still being transcribed; try again soon"
+            )
+        self._uploads.add(path)
         return {"id": session.say_audio(path)}
 
     def _do_answer(self, yes: bool) -> dict[str, Any]:
@@ -301,9 +315,10 @@ class RideManager:
             self._end_session()
             with self._lock:
                 self._state = RideState.FAILED
-                self._error = f"{type(exc).__name__}: {exc}"
+                self._error = redact(f"{type(exc).__name__}: {exc}")
             self._publish({"type": "status", **self.status()})
             return
+        self._uploads.sweep()
         self._next_step = max(self._next_step + self.step_period_s, time.monotonic() - 1.0)
         with self._lock:
             self._history.append(
@@ -331,7 +346,11 @@ class RideManager:
             if exp is not None and index not in self._explained_steps:
                 self._explained_steps.add(index)
                 explanations.append(
-                    {"t": session.records[index].t, "text": exp["text"], "factor": exp["factor"]}
+                    {
+                        "t": session.records[index].t,
+                        "text": redact(exp["text"]),
+                        "factor": exp["factor"],
+                    }
                 )
         pending = session.pending_confirmation
         return finite(
@@ -346,8 +365,8 @@ class RideManager:
                 "limit_mps": round(record.limit_mps, 3),
                 "state": record.state,
                 "flags": record.flags,
-                "passenger": [_public_event(e) for e in record.passenger],
-                "question": pending.question if pending is not None else None,
+                "passenger": redact_json([_public_event(e) for e in record.passenger]),
+                "question": _redacted(pending.question) if pending is not None else None,
                 "explanations": explanations,
                 "scene": snapshot(session.env.sumo, self.scene),
             }
@@ -360,9 +379,7 @@ class RideManager:
                 session.close()
             except Exception:
                 log.exception("error while closing the ride")
-        for path in self._uploads:
-            path.unlink(missing_ok=True)
-        self._uploads = []
+        self._uploads.clear()
 
     def _set_state(self, state: RideState) -> None:
         with self._lock:
@@ -401,6 +418,11 @@ class RideManager:
             "log": list(self._log),
             "frame": self._last_frame,
         }
+
+
+def _redacted(text: str | None) -> str | None:
+    """``text`` with secrets masked (``None`` stays ``None``)."""
+    return redact(text) if text is not None else None
 
 
 def _public_event(event: dict[str, Any]) -> dict[str, Any]:

@@ -6,11 +6,12 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from explaindrive.env.config import TRAFFIC_LEVELS
 from explaindrive.sim.scenario.layout import validate_traffic_level
 
 MAX_TEXT_CHARS = 300  # a spoken request is a sentence or two
 MAX_RIDE_STEPS = 1800  # [s] half an hour of driving
-MAX_TRAFFIC_LEVEL = 3.0  # twice the busiest level the paper evaluates
+MAX_TRAFFIC_LEVEL = max(TRAFFIC_LEVELS)  # the busiest level the scenario is built for
 
 
 class _Strict(BaseModel):
@@ -21,7 +22,7 @@ class StartRequest(_Strict):
     """Start a new ride.
 
     Attributes:
-        traffic_level: demand scale, in (0, 3] (1.0 = 900 veh/h on the main road).
+        traffic_level: demand scale, in (0, 1.5] (1.0 = 900 veh/h on the main road).
         seed: simulation seed; the same seed and level give the same traffic.
         command: the command the car starts with.
         max_steps: longest ride [s].

@@ -30,6 +30,7 @@ from explaindrive.language.decision import (
 from explaindrive.language.explanation import Explainer, Explanation, check_grounding
 from explaindrive.language.intent import IntentInterpreter, IntentResult, parse_confirmation
 from explaindrive.language.summary import StateRecord, describe_action, environment_summary
+from explaindrive.redact import redact
 
 log = logging.getLogger(__name__)
 
@@ -94,8 +95,10 @@ class ChatClient:
         from openai import OpenAI
 
         self.config = config
+        # the key sent to the endpoint, masked in any text that comes back
+        self.secret = config.api_key or os.environ.get("OPENAI_API_KEY")
         self._client = OpenAI(
-            api_key=config.api_key or os.environ.get("OPENAI_API_KEY") or "not-needed",
+            api_key=self.secret or "not-needed",
             base_url=config.base_url or os.environ.get("OPENAI_BASE_URL") or None,
             timeout=config.timeout_s,
             max_retries=config.max_retries,
@@ -116,20 +119,21 @@ class ChatClient:
         )
         if not resp.choices or resp.choices[0].message.content is None:
             raise BackendReplyError("empty reply")
-        return str(resp.choices[0].message.content)
+        return redact(str(resp.choices[0].message.content), [self.secret])
 
 
-def _err(exc: Exception) -> str:
-    return f"{type(exc).__name__}: {exc}"[:300]
+def _err(exc: Exception, client: ChatClient) -> str:
+    """One line for a failed call, secrets masked (the endpoint may echo the key)."""
+    return redact(f"{type(exc).__name__}: {exc}", [client.secret])[:300]
 
 
 _R = TypeVar("_R", IntentResult, Decision, Explanation)
 
 
-def _as_fallback(result: _R, t0: float, exc: Exception) -> _R:
-    """The embedded module's ``result``, marked as a fallback for ``exc``, timed from ``t0``."""
+def _as_fallback(result: _R, t0: float, error: str) -> _R:
+    """The embedded module's ``result``, marked as a fallback for ``error``, timed from ``t0``."""
     return dataclasses.replace(
-        result, fallback=True, latency_s=time.perf_counter() - t0, error=_err(exc)
+        result, fallback=True, latency_s=time.perf_counter() - t0, error=error
     )
 
 
@@ -160,8 +164,9 @@ class OpenAIIntentInterpreter(IntentInterpreter):
                 command, reply.strip().strip("\"'"), NAME, False, time.perf_counter() - t0, {}
             )
         except Exception as exc:  # any endpoint failure: answer offline instead
-            log.warning("openai intent failed, using embedded: %s", _err(exc))
-            return _as_fallback(self.fallback.interpret(text), t0, exc)
+            error = _err(exc, self.client)
+            log.warning("openai intent failed, using embedded: %s", error)
+            return _as_fallback(self.fallback.interpret(text), t0, error)
 
 
 class OpenAIDecider(ExplanationDecider):
@@ -197,8 +202,9 @@ class OpenAIDecider(ExplanationDecider):
                 latency_s=time.perf_counter() - t0,
             )
         except Exception as exc:
-            log.warning("openai decision failed, using rules: %s", _err(exc))
-            return _as_fallback(self.fallback.decide(record), t0, exc)
+            error = _err(exc, self.client)
+            log.warning("openai decision failed, using rules: %s", error)
+            return _as_fallback(self.fallback.decide(record), t0, error)
 
 
 class OpenAIExplainer(Explainer):
@@ -230,5 +236,6 @@ class OpenAIExplainer(Explainer):
                 raise BackendReplyError(f"explanation names factors not in the state: {names}")
             return Explanation(reply, factor, NAME, latency_s=time.perf_counter() - t0)
         except Exception as exc:
-            log.warning("openai explanation failed, using templates: %s", _err(exc))
-            return _as_fallback(self.fallback.explain(record, factor), t0, exc)
+            error = _err(exc, self.client)
+            log.warning("openai explanation failed, using templates: %s", error)
+            return _as_fallback(self.fallback.explain(record, factor), t0, error)
