@@ -16,7 +16,10 @@ The serial bound is what a loop that neither overlaps nor wastes anything would 
 run's pool are warmed up before anything is timed, so that the figure is the steady state
 of a run whose warm-up states are cached (the first run on a machine also builds them).
 
-    python benchmarks/bench_train.py [--episodes 40] [--envs 2] [--seed-pool 8]
+With ``--ray`` the same run is repeated with the workers as actors on a local Ray and the
+ratio of its throughput to the local process workers' is printed (target >= 0.8).
+
+    python benchmarks/bench_train.py [--episodes 40] [--envs 2] [--seed-pool 8] [--ray]
 """
 
 from __future__ import annotations
@@ -79,9 +82,9 @@ def update_time(config: TrainConfig, rng: np.random.Generator, updates: int = 10
     return (time.perf_counter() - t0) / updates
 
 
-def trainer_rate(config: TrainConfig, out: Path) -> tuple[float, int]:
+def trainer_rate(config: TrainConfig, out: Path, use_ray: bool = False) -> tuple[float, int]:
     """Env steps/s of the trainer once updates run, and the steps that rate spans."""
-    train(config, out)
+    train(config, out, use_ray=use_ray)
     with (out / "episodes.csv").open(newline="") as f:
         rows = [r for r in csv.DictReader(f) if int(r["env_steps"]) > config.learning_starts]
     first, last = rows[0], rows[-1]
@@ -95,6 +98,7 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=40, help="episodes the trainer plays")
     parser.add_argument("--envs", type=int, default=2, help="SUMO worker processes")
     parser.add_argument("--seed-pool", type=int, default=8, help="seeds the episodes use")
+    parser.add_argument("--ray", action="store_true", help="also train with Ray workers")
     args = parser.parse_args()
 
     config = preset(args.preset).replace(
@@ -107,6 +111,8 @@ def main() -> None:
     bound = 1.0 / (t_env + t_update / config.train_frequency)
     with tempfile.TemporaryDirectory() as tmp:
         rate, steps = trainer_rate(config, Path(tmp) / "run")
+        if args.ray:
+            ray_rate, ray_steps = trainer_rate(config, Path(tmp) / "ray", use_ray=True)
 
     print(f"preset, envs, episodes       {args.preset}, {args.envs}, {args.episodes}")
     print(f"bare env step                {t_env * 1e3:8.3f} ms")
@@ -115,6 +121,9 @@ def main() -> None:
     print(f"serial bound                 {bound:8.0f} env steps/s")
     print(f"trainer, {steps:,} steps       {rate:8.0f} env steps/s")
     print(f"ratio trainer / bound        {rate / bound:8.2f}   (target >= 0.5)")
+    if args.ray:
+        print(f"trainer on Ray, {ray_steps:,} steps {ray_rate:8.0f} env steps/s")
+        print(f"ratio Ray / local processes  {ray_rate / rate:8.2f}   (target >= 0.8)")
 
 
 if __name__ == "__main__":
