@@ -24,7 +24,7 @@ from explaindrive.agent.workers import RoundResult, WorkerLost
 
 log = logging.getLogger(__name__)
 
-RAY_MISSING = "--ray needs Ray, which is not installed: pip install 'explaindrive[ray]'"
+RAY_MISSING = "Ray is not installed: pip install 'explaindrive[ray]'"
 
 
 def require_ray() -> ModuleType:

@@ -1,7 +1,8 @@
-"""Options shared by ``explaindrive evaluate`` and ``explaindrive report``: one place each."""
+"""Options shared by ``explaindrive evaluate``, ``report`` and ``train``: one place each."""
 
 from __future__ import annotations
 
+import importlib.util
 from pathlib import Path
 from typing import Annotated
 
@@ -31,7 +32,12 @@ MaxStepsOption = Annotated[
 
 
 def check_ray_target(ray: bool, ray_address: str | None) -> str | None:
-    """The error message when both ``--ray`` and ``--ray-address`` are given, else ``None``."""
+    """The error message when both ``--ray`` and ``--ray-address`` are given, or when either
+    is given without Ray installed; else ``None``."""
     if ray and ray_address:
         return "give --ray or --ray-address, not both"
+    if (ray or ray_address) and importlib.util.find_spec("ray") is None:
+        from explaindrive.agent.ray_pool import RAY_MISSING
+
+        return RAY_MISSING
     return None

@@ -18,7 +18,6 @@ from explaindrive.agent.config import (
     load_config_file,
     parse_override,
 )
-from explaindrive.agent.ray_pool import require_ray
 from explaindrive.cli._errors import error_line
 from explaindrive.cli._grid_options import check_ray_target
 
@@ -127,8 +126,6 @@ def train_command(
     try:
         if (problem := check_ray_target(ray, ray_address)) is not None:
             raise ConfigError(problem)
-        if ray or ray_address:
-            require_ray()
         config = resolve_config(
             mode.strip().lower(), preset, config_file, overrides or [], out, resume,
             episodes=episodes, num_envs=envs, seed=seed,
