@@ -119,4 +119,4 @@ def test_overrides_are_counted_with_and_without_the_shield(tmp_path: Path) -> No
         ctrl = MergedController(eager, eager, use_shield=use_shield)
         assert ctrl.act(OBS) == 6 and not ctrl.last_override  # 8 m/s: +3 is fine
         assert ctrl.act(fast) == expected and ctrl.last_override
-        assert (ctrl.steps, ctrl.overrides) == (2, 1)
+        assert (ctrl.steps, ctrl.overrides, ctrl.last_network_action) == (2, 1, 6)

@@ -79,8 +79,9 @@ class MergedController:
         use_shield: pass the greedy action through the kinematic safety shield
             (:mod:`explaindrive.agent.shield`). Either way ``overrides`` counts the steps
             in which the shield replaced the network's choice (or, without the shield,
-            would have), ``steps`` the actions chosen, and ``last_override`` tells whether
-            the last action was such a step.
+            would have), ``steps`` the actions chosen, ``last_override`` tells whether
+            the last action was such a step and ``last_network_action`` is what the network
+            chose in it.
     """
 
     def __init__(
@@ -97,6 +98,7 @@ class MergedController:
         self.overrides = 0
         self.steps = 0
         self.last_override = False
+        self.last_network_action: int | None = None
         self._stop_steps_left: int | None = None  # under STOP: steps left to a standstill
         self.set_command(command)
 
@@ -158,6 +160,7 @@ class MergedController:
         q_values = self.policy.q_values(x)
         decision = shield(x, q_values, steps_left)
         self.steps += 1
+        self.last_network_action = int(np.argmax(q_values))
         self.last_override = decision.overridden
         self.overrides += int(decision.overridden)
-        return decision.action if self.use_shield else int(np.argmax(q_values))
+        return decision.action if self.use_shield else self.last_network_action
