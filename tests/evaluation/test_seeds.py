@@ -25,3 +25,16 @@ def test_seed_table_lists_each_run_then_mean_and_spread() -> None:
     assert cells[3][2] == "1.000" and cells[3][7] == "1.000"  # population std
     steps = runs[1].steps
     assert cells[1][-1].rstrip(" |") == f"{100 * 4 / steps:.3f}"
+
+
+def test_report_includes_seed_tables_under_their_run_folder(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from explaindrive.evaluation.report import seeds_section
+
+    table = tmp_path / "fast-seeds" / "seeds.md"
+    table.parent.mkdir()
+    table.write_text("# Training seeds: bare networks, seeds 1000-1009\n\n| run |\n| --- |\n")
+    text = seeds_section([table])
+    assert "## Training seeds" in text
+    assert "### fast-seeds: Training seeds: bare networks, seeds 1000-1009" in text
+    assert "| run |" in text
+    assert seeds_section([]) == ""

@@ -60,6 +60,10 @@ def report_command(
     ray: RayOption = False,
     ray_address: RayAddressOption = None,
     max_steps: MaxStepsOption = 1000,
+    seed_tables: Annotated[
+        list[Path] | None,
+        typer.Option("--seed-table", help="A seeds.md of train --seeds to include (repeatable)."),
+    ] = None,
 ) -> None:
     """Evaluate the policies and baselines and rewrite the results document and figures."""
     from explaindrive.agent.checkpoint import CheckpointError
@@ -69,6 +73,10 @@ def report_command(
 
     if (problem := check_ray_target(ray, ray_address)) is not None:
         err_console.print(error_line(problem))
+        raise typer.Exit(2)
+    missing = [p for p in seed_tables or [] if not p.is_file()]
+    if missing:
+        err_console.print(error_line(f"seed table not found: {missing[0]}"))
         raise typer.Exit(2)
     try:
         names = parse_policy_list(policies)
@@ -95,6 +103,7 @@ def report_command(
                 plan, out, figures_dir=figures, training_runs=training, json_file=json_file,
                 command_line=command_line, workers=workers, use_ray=ray, ray_address=ray_address,
                 progress=lambda done, _total: bar.update(task, completed=done),
+                seed_tables=seed_tables or [],
             )  # fmt: skip
     except (CheckpointError, RuntimeError) as exc:
         err_console.print(error_line(exc))

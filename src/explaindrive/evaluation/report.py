@@ -147,6 +147,7 @@ def run_report(
     use_ray: bool = False,
     ray_address: str | None = None,
     progress: Progress | None = None,
+    seed_tables: Sequence[Path] = (),
 ) -> ReportResult:
     """Evaluate every run of ``plan``, write the figures, and return the document's Markdown.
 
@@ -161,6 +162,7 @@ def run_report(
         use_ray: run on a local Ray.
         ray_address: run on this Ray cluster.
         progress: called after each finished episode.
+        seed_tables: ``seeds.md`` files of ``train --seeds`` runs to include.
     """
     figures_dir = figures_dir or out_md.parent / "figures"
     specs = [ep for run in plan.runs for ep in run.episodes]
@@ -179,7 +181,34 @@ def run_report(
     if json_file is not None:
         write_json(json_file, [run_document(name, recs) for name, recs in by_run.items()])
     md = _markdown(plan, summaries, by_run, written, out_md, command_line)
+    md += shield_section(plan, by_run) + seeds_section(seed_tables)
     return ReportResult(md, written, by_run)
+
+
+def shield_section(plan: ReportPlan, by_run: Mapping[str, list[EpisodeRecord]]) -> str:
+    """How often the safety shield replaced each agent's action, run by run."""
+    lines = ["", "## Safety shield", ""]
+    for name, records in by_run.items():
+        base = name.split(" ")[0]
+        if base not in plan.policies or plan.policies[base].kind == "baseline":
+            continue
+        steps = sum(r.result.steps for r in records)
+        overrides = sum(r.shield_overrides for r in records)
+        shielded = plan.policies[base].shield
+        lines.append(f"- {name}: " + tables.shield_line(overrides, steps, shielded))
+    return "\n".join(lines) + "\n" if len(lines) > 3 else ""
+
+
+def seeds_section(paths: Sequence[Path]) -> str:
+    """The ``seeds.md`` tables of training-seed runs, each under its run folder's name."""
+    if not paths:
+        return ""
+    lines = ["", "## Training seeds", ""]
+    for path in paths:
+        body = path.read_text(encoding="utf-8").strip().splitlines()
+        title = body[0].lstrip("# ") if body and body[0].startswith("#") else ""
+        lines += [f"### {path.parent.name}: {title}", "", *body[1:], ""]
+    return "\n".join(lines)
 
 
 def _speed_panels(
