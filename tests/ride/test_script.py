@@ -14,6 +14,7 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
 
 
 def test_yaml_script_is_sorted_and_resolves_audio(tmp_path):
+    (tmp_path / "a.wav").write_bytes(b"RIFF")
     path = write(
         tmp_path, "s.yaml", "- {t: 30, audio: a.wav}\n- {t: 0, say: hurry, confirm: yes}\n"
     )
@@ -57,3 +58,24 @@ def test_bad_scripts_are_refused_clearly(tmp_path, text, message):
 def test_unreadable_script(tmp_path):
     with pytest.raises(ScriptError, match="cannot read ride script"):
         load_script(tmp_path / "missing.yaml")
+
+
+def test_a_missing_audio_file_is_refused_at_load(tmp_path):
+    (tmp_path / "here.wav").write_bytes(b"RIFF")
+    path = write(tmp_path, "s.yaml", "- {t: 0, audio: here.wav}\n- {t: 5, audio: gone.wav}\n")
+    with pytest.raises(ScriptError) as err:
+        load_script(path)
+    assert str(err.value) == (
+        f"ride script {path}, line 2: audio file not found: {tmp_path / 'gone.wav'}"
+    )
+
+
+def test_a_script_that_is_not_utf8_names_the_file(tmp_path):
+    path = tmp_path / "latin1.yaml"
+    path.write_bytes('- {t: 0, say: "schneller bitte, ich bin spät"}\n'.encode("latin-1"))
+    with pytest.raises(ScriptError) as err:
+        load_script(path)
+    assert (
+        str(err.value)
+        == f"ride script {path} is not UTF-8 text (byte 42: invalid continuation byte)"
+    )

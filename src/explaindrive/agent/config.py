@@ -23,6 +23,7 @@ from typing import Any
 import yaml
 
 from explaindrive.commands import Command
+from explaindrive.env.config import TRAFFIC_LEVELS
 from explaindrive.sim.scenario.layout import validate_traffic_level
 
 _NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
@@ -240,6 +241,9 @@ def _problems(c: TrainConfig) -> typing.Iterator[str]:
             validate_traffic_level(level)
         except ValueError as exc:
             yield f"traffic_levels: {exc}"
+        else:  # a busier road stays blocked: the ego cannot enter, no episode starts
+            if level > (busiest := max(TRAFFIC_LEVELS)):
+                yield f"traffic_levels: {level:g} is above the scenario's busiest level {busiest:g}"
     for name in ("stop_gap_s", "stop_duration_s"):
         lo, hi = getattr(c, name)
         if not 0 < lo <= hi:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
+import json
+import math
 from pathlib import Path
 from typing import Annotated
 
@@ -26,7 +29,7 @@ def explain_command(
 ) -> None:
     """Decide whether a step's action needs explaining and, if so, explain it."""
     try:
-        record = StateRecord.load(case)
+        record = read_case(case)
         from explaindrive.language.stack import make_language_stack
 
         stack = make_language_stack(backend, load_config(config))
@@ -53,6 +56,40 @@ def explain_command(
     console.print(f"[bold]{decision.tag}[/] ({decision.reason})", highlight=False)
     if text:
         console.print(text, highlight=False)
+
+
+def read_case(path: Path) -> StateRecord:
+    """The state record in ``path``; every number in it must be finite.
+
+    Raises:
+        FileNotFoundError: if the file does not exist.
+        ValueError: naming the file, if it is not UTF-8, not JSON, holds NaN or an
+            infinity, or is not a valid record.
+    """
+    if not path.is_file():
+        raise FileNotFoundError(f"state record file not found: {path}")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path}: not UTF-8 text (byte {exc.start}: {exc.reason})") from exc
+    _check_finite(text, str(path))
+    return StateRecord.from_json(text, source=str(path))
+
+
+def _check_finite(text: str, source: str) -> None:
+    """Refuse ``NaN``, ``Infinity`` and numbers too large for a float in JSON ``text``."""
+
+    def constant(name: str) -> float:
+        raise ValueError(f"{source}: {name} is not allowed; give a finite number, or null")
+
+    def number(literal: str) -> float:
+        value = float(literal)
+        if not math.isfinite(value):
+            raise ValueError(f"{source}: {literal[:40]} is not a finite number")
+        return value
+
+    with contextlib.suppress(json.JSONDecodeError):  # from_json says where JSON is malformed
+        json.loads(text, parse_constant=constant, parse_float=number)
 
 
 def register(app: typer.Typer) -> None:

@@ -7,6 +7,8 @@ import logging
 
 import typer
 
+from explaindrive.redact import RedactingFilter
+
 app = typer.Typer(
     name="explaindrive",
     help="Passenger-directed, explainable autonomous driving in SUMO.",
@@ -38,6 +40,9 @@ def _root(verbose: bool = typer.Option(False, "--verbose", "-v", help="Debug log
         level=logging.DEBUG if verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
+    for handler in logging.getLogger().handlers:  # keys never reach a log line
+        if not any(isinstance(f, RedactingFilter) for f in handler.filters):
+            handler.addFilter(RedactingFilter())
 
 
 for _name in _COMMAND_MODULES:

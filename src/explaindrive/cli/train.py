@@ -18,7 +18,7 @@ from explaindrive.agent.config import (
     load_config_file,
     parse_override,
 )
-from explaindrive.cli._errors import error_line
+from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import check_ray_target
 
 console = Console()
@@ -133,7 +133,7 @@ def train_command(
         trainer = Trainer(config, out, resume=resume, show_progress=progress, use_ray=ray,
                           ray_address=ray_address)  # fmt: skip
     except (ConfigError, CheckpointError) as exc:
-        console.print(error_line(exc))
+        print_error(console, exc)
         raise typer.Exit(2) from None
     console.print(
         f"training [bold]{config.mode}[/bold]: {config.episodes} episodes on {config.envs} "
@@ -196,7 +196,7 @@ def _train_seeds(
             raise ConfigError("give --seed or --seeds, not both")
         seeds = parse_seeds(seeds_text)
     except (ConfigError, SpecError) as exc:
-        console.print(error_line(exc))
+        print_error(console, exc)
         raise typer.Exit(2) from None
     out = out or Path("runs") / f"{mode}-seeds"
     console.print(f"training {mode} with seeds {', '.join(map(str, seeds))} side by side -> {out}")

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+from explaindrive.env.config import TRAFFIC_LEVELS
 from explaindrive.language.backends import check_backend
 from explaindrive.sim.scenario.layout import validate_traffic_level
+
+MAX_TRAFFIC_LEVEL = max(TRAFFIC_LEVELS)  # the busiest level the scenario is built for
 
 
 @dataclass(frozen=True, slots=True)
@@ -13,7 +17,7 @@ class RideConfig:
     """Settings of :class:`~explaindrive.ride.session.RideSession`.
 
     Attributes:
-        traffic_level: demand scale (1.0 = 900 veh/h on the main road).
+        traffic_level: demand scale, in (0, 1.5] (1.0 = 900 veh/h on the main road).
         seed: simulation seed.
         max_steps: longest ride [steps of 1 s].
         backend: language backend (``embedded`` or ``openai``).
@@ -44,6 +48,11 @@ class RideConfig:
 
     def __post_init__(self) -> None:
         validate_traffic_level(self.traffic_level)
+        if self.traffic_level > MAX_TRAFFIC_LEVEL:
+            raise ValueError(
+                f"traffic level {self.traffic_level:g} is above the busiest level the scenario "
+                f"is built for ({MAX_TRAFFIC_LEVEL:g}); the ego could not enter the road"
+            )
         if self.max_steps <= 0:
             raise ValueError(f"max_steps must be > 0, got {self.max_steps}")
         if not 0 <= self.seed < 2**31:
@@ -54,6 +63,7 @@ class RideConfig:
             "audio_deadline_s",
             "explain_deadline_s",
         ):
-            if getattr(self, name) < 0:
-                raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} must be a finite number >= 0, got {value}")
         check_backend(self.backend)

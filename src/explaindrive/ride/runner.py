@@ -1,10 +1,20 @@
-"""Run a ride to its end: script lines in, ``events.jsonl``/``summary.json``/``ride.png`` out."""
+"""Run a ride to its end: script lines in, ``events.jsonl``/``summary.json``/``ride.png`` out.
+
+The output folder holds one ride at every moment: :func:`prepare_out_dir` refuses a
+folder that holds anything (unless told to replace a previous ride's files), steps are
+appended to ``events.jsonl`` as soon as late language results can no longer change
+them, and the figure and the summary are written last, each under a temporary name
+first. A ride that is stopped (Ctrl+C, see ``stop``) or fails still writes every step
+it drove, then its figure and its summary, marked ``interrupted`` with the reason.
+"""
 
 from __future__ import annotations
 
 import json
 import logging
+import os
 import queue
+import threading
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -14,6 +24,7 @@ from typing import IO, Any
 
 from explaindrive.jsonsafe import finite
 from explaindrive.language.intent import parse_confirmation_answer
+from explaindrive.redact import redact, redact_json
 from explaindrive.ride.plot import plot_ride
 from explaindrive.ride.script import AUDIO_PREFIX, ScriptLine
 from explaindrive.ride.session import RideSession, StepRecord
@@ -21,15 +32,54 @@ from explaindrive.ride.session import RideSession, StepRecord
 log = logging.getLogger(__name__)
 
 WRITE_LAG_STEPS = 3  # records are written once late language results can no longer change them
+EVENTS_NAME, SUMMARY_NAME, FIGURE_NAME = "events.jsonl", "summary.json", "ride.png"
+STOPPED = "stopped by the passenger (Ctrl+C)"
+
+
+class OutputDirError(ValueError):
+    """The output folder cannot take a new ride."""
 
 
 @dataclass(frozen=True)
 class RideOutputs:
-    """Files a ride wrote."""
+    """Files a ride wrote, and why it ended early (``None``: it ran to its end)."""
 
     events: Path
     summary: Path
     figure: Path
+    interrupted: str | None = None
+
+
+def output_files(out_dir: Path) -> RideOutputs:
+    """Where a ride in ``out_dir`` writes its files."""
+    return RideOutputs(out_dir / EVENTS_NAME, out_dir / SUMMARY_NAME, out_dir / FIGURE_NAME)
+
+
+def prepare_out_dir(out_dir: Path, force: bool = False) -> RideOutputs:
+    """Make ``out_dir`` ready for a new ride: created if missing, refused if it holds files.
+
+    Args:
+        out_dir: the ride's output folder.
+        force: delete a previous ride's files (``events.jsonl``, ``summary.json``,
+            ``ride.png``) instead of refusing; anything else in the folder is kept.
+
+    Raises:
+        OutputDirError: if ``out_dir`` is a file, or holds files and ``force`` is off.
+    """
+    if out_dir.exists() and not out_dir.is_dir():
+        raise OutputDirError(f"--out {out_dir} is a file, not a folder; name a folder")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    outputs = output_files(out_dir)
+    entries = sorted(p.name for p in out_dir.iterdir())
+    if entries and not force:
+        shown = ", ".join(entries[:3]) + (", ..." if len(entries) > 3 else "")
+        raise OutputDirError(
+            f"--out {out_dir} is not empty ({shown}); choose a new folder, or add --force "
+            "to replace the ride in it"
+        )
+    for path in (outputs.events, outputs.summary, outputs.figure):
+        path.unlink(missing_ok=True)
+    return outputs
 
 
 def _json_default(value: Any) -> Any:
@@ -39,8 +89,23 @@ def _json_default(value: Any) -> Any:
 
 
 def _write(fh: IO[str], rec: StepRecord) -> None:
-    fh.write(json.dumps(finite(rec.to_json()), default=_json_default) + "\n")
+    line = redact_json(finite(rec.to_json()))
+    fh.write(json.dumps(line, default=_json_default) + "\n")
     fh.flush()
+
+
+class _EventLog:
+    """``events.jsonl``, written step by step, ``WRITE_LAG_STEPS`` behind the ride."""
+
+    def __init__(self, fh: IO[str]) -> None:
+        self.fh = fh
+        self.written = 0
+
+    def catch_up(self, records: Sequence[StepRecord], lag: int = WRITE_LAG_STEPS) -> None:
+        """Write every record but the last ``lag`` ones."""
+        while self.written < len(records) - lag:
+            _write(self.fh, records[self.written])
+            self.written += 1
 
 
 def run_ride(
@@ -50,55 +115,108 @@ def run_ride(
     *,
     typed: queue.Queue[str] | None = None,
     on_step: Callable[[StepRecord], None] | None = None,
+    stop: threading.Event | None = None,
 ) -> RideOutputs:
-    """Drive ``session`` to the end of the ride.
+    """Drive ``session`` to the end of the ride (or until ``stop`` is set).
 
     Args:
         session: a fresh ride session (started here).
         lines: timed passenger lines (already validated).
-        out_dir: where ``events.jsonl``, ``summary.json`` and ``ride.png`` go.
+        out_dir: where ``events.jsonl``, ``summary.json`` and ``ride.png`` go (see
+            :func:`prepare_out_dir`; created here if missing).
         typed: lines typed by the passenger while the ride runs (interactive mode);
             "yes"/"no" answers a pending confirmation question.
         on_step: called after every step (live view).
+        stop: when set, the ride ends after the current step and is marked interrupted.
+
+    Returns:
+        The files written; ``interrupted`` says why the ride ended early (``stop`` set,
+        or a ``KeyboardInterrupt``, which ends the ride the same way).
+
+    Raises:
+        Exception: whatever error stopped the ride, once the outputs are written.
     """
     out_dir.mkdir(parents=True, exist_ok=True)
-    outputs = RideOutputs(out_dir / "events.jsonl", out_dir / "summary.json", out_dir / "ride.png")
+    outputs = output_files(out_dir)
     todo = deque(lines)
-    held: list[str] = []  # typed answers waiting for their question
-    written = 0
-    session.start()
+    failure: Exception | None = None
+    reason: str | None = None
     try:
+        session.start()
         with outputs.events.open("w", encoding="utf-8") as fh:
-            while not session.done:
-                tick = time.monotonic()
-                while todo and todo[0].t <= session.t:
-                    line = todo.popleft()
-                    if line.audio is not None:
-                        session.say_audio(line.audio, confirm=line.confirm)
-                    else:
-                        session.say(line.say or "", confirm=line.confirm)
-                _drain_typed(session, typed, held)
-                rec = session.step()
-                if on_step is not None:
-                    on_step(rec)
-                while written < len(session.records) - WRITE_LAG_STEPS:
-                    _write(fh, session.records[written])
-                    written += 1
-                if session.config.realtime:
-                    time.sleep(max(0.0, 1.0 - (time.monotonic() - tick)))
-            for rec in session.records[written:]:
-                _write(fh, rec)
+            events = _EventLog(fh)
+            try:
+                _drive(session, todo, events, typed, on_step, stop)
+                reason = None if session.done else STOPPED
+            except KeyboardInterrupt:
+                reason = STOPPED
+            except Exception as exc:
+                failure = exc
+                reason = redact(f"stopped on an error: {type(exc).__name__}: {exc}")
+            finally:
+                events.catch_up(session.records, lag=0)
     finally:
         session.close()
+    _finish(session, todo, outputs, events.written, reason)
+    if failure is not None:
+        raise failure
+    return RideOutputs(outputs.events, outputs.summary, outputs.figure, reason)
+
+
+def _drive(
+    session: RideSession,
+    todo: deque[ScriptLine],
+    events: _EventLog,
+    typed: queue.Queue[str] | None,
+    on_step: Callable[[StepRecord], None] | None,
+    stop: threading.Event | None,
+) -> None:
+    """The ride loop: due lines, typed input, one step, the event log, the pace."""
+    held: list[str] = []  # typed answers waiting for their question
+    while not session.done and not (stop is not None and stop.is_set()):
+        tick = time.monotonic()
+        while todo and todo[0].t <= session.t:
+            line = todo.popleft()
+            if line.audio is not None:
+                session.say_audio(line.audio, confirm=line.confirm)
+            else:
+                session.say(line.say or "", confirm=line.confirm)
+        _drain_typed(session, typed, held)
+        rec = session.step()
+        if on_step is not None:
+            on_step(rec)
+        events.catch_up(session.records)
+        if session.config.realtime:
+            pause_s = max(0.0, 1.0 - (time.monotonic() - tick))
+            if stop is not None:
+                stop.wait(pause_s)
+            else:
+                time.sleep(pause_s)
+
+
+def _finish(
+    session: RideSession,
+    todo: deque[ScriptLine],
+    outputs: RideOutputs,
+    steps: int,
+    reason: str | None,
+) -> None:
+    """Write the figure, then the summary (each under a temporary name first)."""
     summary = session.summary()
+    summary["steps"] = steps
+    summary["interrupted"] = reason is not None
+    summary["interruption"] = reason
     summary["unused_script_lines"] = [line.model_dump(mode="json") for line in todo]
-    outputs.summary.write_text(json.dumps(finite(summary), indent=2, default=_json_default))
-    plot_ride(
-        session.records,
-        outputs.figure,
-        title=f"Ride: traffic {session.config.traffic_level:g}, seed {session.config.seed}",
-    )
-    return outputs
+    title = f"Ride: traffic {session.config.traffic_level:g}, seed {session.config.seed}"
+    if reason is not None:
+        title += f" (interrupted after {steps} s)"
+    figure_tmp = outputs.figure.with_name(f".{outputs.figure.stem}.tmp.png")
+    plot_ride(session.records[:steps], figure_tmp, title=title)
+    os.replace(figure_tmp, outputs.figure)
+    summary_tmp = outputs.summary.with_name(f".{outputs.summary.name}.tmp")
+    text = json.dumps(redact_json(finite(summary)), indent=2, default=_json_default)
+    summary_tmp.write_text(text, encoding="utf-8")
+    os.replace(summary_tmp, outputs.summary)
 
 
 def _drain_typed(

@@ -8,7 +8,8 @@ A script is a YAML or JSON list (or a mapping with a ``lines`` list)::
 
 ``t`` is the ride time in seconds; ``confirm`` answers the confirmation question
 (``yes``/``no``; omitted: the ride's ``--auto-confirm`` decides, else the line
-stays unconfirmed). Relative audio paths are resolved against the script's folder.
+stays unconfirmed). Relative audio paths are resolved against the script's folder;
+an audio file that does not exist is an error when the script is read.
 """
 
 from __future__ import annotations
@@ -59,6 +60,10 @@ def _read(path: Path) -> object:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ScriptError(f"cannot read ride script {path}: {exc.strerror or exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise ScriptError(
+            f"ride script {path} is not UTF-8 text (byte {exc.start}: {exc.reason})"
+        ) from exc
     try:
         if path.suffix.lower() == ".json":
             return json.loads(text)
@@ -95,6 +100,8 @@ def load_script(path: str | Path, max_time_s: float | None = None) -> list[Scrip
             ) from exc
         if line.audio is not None and not line.audio.is_absolute():
             line = line.model_copy(update={"audio": path.parent / line.audio})
+        if line.audio is not None and not line.audio.is_file():
+            raise ScriptError(f"ride script {path}, line {i}: audio file not found: {line.audio}")
         if max_time_s is not None and line.t > max_time_s:
             raise ScriptError(
                 f"ride script {path}, line {i}: t={line.t:g} s is after the end of the ride "
