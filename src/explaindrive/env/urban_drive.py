@@ -539,59 +539,25 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     ) -> tuple[NDArray[np.float32], _Leader | None, _Leader | None]:
         """Observation, effective leader (real or virtual) and real leader.
 
-        ``ego`` is the ego's subscription result of the current step.
+        ``ego`` is the ego's subscription result of the current step. The effective leader
+        is the nearest of the real leader, a red or yellow light's stop line and an
+        occupied crossing.
         """
         ep = self._episode()
         v = float(ego[tc.VAR_SPEED])
-        pos = ep.pos_m
         rng = S.SENSOR_RANGE_M
-
-        real: _Leader | None = None
-        lead = ego.get(tc.VAR_LEADER)
-        gap = float(lead[1]) + self._ego_min_gap_m if lead and lead[0] else rng  # bumper gap
-        if gap < rng:
-            lid = lead[0]
-            length = self._leader_len.get(lid)
-            if length is None:
-                length = self._leader_len[lid] = float(api.vehicle.getLength(lid))
-            real = _Leader(max(gap, 0.0), float(api.vehicle.getSpeed(lid)), length, False)
+        real = self._real_leader(api, ego)
         leader = real
-
-        d_tl, tls = rng, S.LightState.GREEN
-        ep.light_state = {}
-        for light in self.geometry.lights:
-            ahead = light.stop_line_m - pos
-            if ahead < 0.0 or light.tls_id not in self._tls_link:
-                continue
-            states = api.trafficlight.getSubscriptionResults(light.tls_id)
-            colour = S.LightState.from_sumo(
-                states[tc.TL_RED_YELLOW_GREEN_STATE][self._tls_link[light.tls_id]]
-            )
-            ep.light_state[light.tls_id] = colour
-            if ahead < rng:
-                d_tl, tls = ahead, colour
-            break
+        d_tl, tls = self._next_light(api, ep.pos_m)
         if d_tl < rng and tls is not S.LightState.GREEN and (leader is None or d_tl < leader.gap_m):
             leader = _Leader(max(d_tl, 0.0), 0.0, 0.0, True)
-
-        d_cross = rng
-        ep.occupied = {}
-        for crossing in self.geometry.crossings:
-            ahead = crossing.stop_line_m - pos
-            # Relevant from sensor range until the ego's front has left the junction: a car
-            # stopped on the crossing (e.g. by a STOP command) must not roll into pedestrians.
-            if crossing.stop_line_m - crossing.end_m <= ahead < rng:
-                busy, on_crossing = self._crossing_occupied(crossing, on_it=ahead < 0.0)
-                ep.occupied[crossing.crossing_edge] = on_crossing
-                if busy:
-                    d_cross = min(d_cross, max(ahead, 0.0))
+        d_cross = self._next_busy_crossing(ep.pos_m)
         if d_cross < rng and (leader is None or d_cross < leader.gap_m):
             leader = _Leader(d_cross, 0.0, 0.0, True)
-
         values = (
             float(ep.command),
             v,
-            self.geometry.posted_limit(pos),
+            self.geometry.posted_limit(ep.pos_m),
             leader.gap_m if leader else rng,
             (v - leader.speed_mps) if leader else 0.0,
             d_tl,
@@ -605,6 +571,55 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             dtype=np.float32,
         )
         return obs, leader, real
+
+    def _real_leader(self, api: Any, ego: Any) -> _Leader | None:
+        """The vehicle ahead in the ego's lane within sensor range (bumper-to-bumper gap)."""
+        lead = ego.get(tc.VAR_LEADER)
+        gap = float(lead[1]) + self._ego_min_gap_m if lead and lead[0] else S.SENSOR_RANGE_M
+        if gap >= S.SENSOR_RANGE_M:
+            return None
+        lid = lead[0]
+        length = self._leader_len.get(lid)
+        if length is None:
+            length = self._leader_len[lid] = float(api.vehicle.getLength(lid))
+        return _Leader(max(gap, 0.0), float(api.vehicle.getSpeed(lid)), length, False)
+
+    def _next_light(self, api: Any, pos: float) -> tuple[float, S.LightState]:
+        """Distance to the next light's stop line and its colour (range and green when
+        none is in range); records the colours the ego's lights show."""
+        ep = self._episode()
+        d_tl, tls = S.SENSOR_RANGE_M, S.LightState.GREEN
+        ep.light_state = {}
+        for light in self.geometry.lights:
+            ahead = light.stop_line_m - pos
+            if ahead < 0.0 or light.tls_id not in self._tls_link:
+                continue
+            states = api.trafficlight.getSubscriptionResults(light.tls_id)
+            colour = S.LightState.from_sumo(
+                states[tc.TL_RED_YELLOW_GREEN_STATE][self._tls_link[light.tls_id]]
+            )
+            ep.light_state[light.tls_id] = colour
+            if ahead < S.SENSOR_RANGE_M:
+                d_tl, tls = ahead, colour
+            break
+        return d_tl, tls
+
+    def _next_busy_crossing(self, pos: float) -> float:
+        """Distance to the nearest crossing a pedestrian is on or entering (range if none);
+        records which crossings have a pedestrian on them."""
+        ep = self._episode()
+        d_cross = S.SENSOR_RANGE_M
+        ep.occupied = {}
+        for crossing in self.geometry.crossings:
+            ahead = crossing.stop_line_m - pos
+            # Relevant from sensor range until the ego's front has left the junction: a car
+            # stopped on the crossing (e.g. by a STOP command) must not roll into pedestrians.
+            if crossing.stop_line_m - crossing.end_m <= ahead < S.SENSOR_RANGE_M:
+                busy, on_crossing = self._crossing_occupied(crossing, on_it=ahead < 0.0)
+                ep.occupied[crossing.crossing_edge] = on_crossing
+                if busy:
+                    d_cross = min(d_cross, max(ahead, 0.0))
+        return d_cross
 
     def _ran_red_light(self, prev_pos: float, pos: float) -> bool:
         """The ego's front crossed a stop line during this step while the light was red.

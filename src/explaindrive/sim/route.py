@@ -77,63 +77,110 @@ def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGe
         ValueError: if the route is not drivable in the network.
     """
     root = ET.parse(net_file).getroot()
-    lanes = _lane_lengths(root)
-    edge_lane: dict[str, str] = {}
-    for edge in root.iter("edge"):
-        if edge.get("function"):
-            continue
-        for lane in edge.iter("lane"):
-            if "pedestrian" not in (lane.get("allow") or "").split():
-                edge_lane[edge.attrib["id"]] = lane.attrib["id"]  # the vehicle lane
-    conns: dict[tuple[str, str], ET.Element] = {}
-    via_next: dict[str, str] = {}
-    for c in root.iter("connection"):
-        src, dst = c.attrib["from"], c.attrib["to"]
-        if src.startswith(":"):
-            if c.get("via"):
-                via_next[f"{src}_{c.attrib['fromLane']}"] = c.attrib["via"]
-            continue
-        if dst in edge_lane and c.get("via"):
-            lane_from = f"{src}_{c.attrib['fromLane']}"
-            if lane_from == edge_lane.get(src):
-                conns[(src, dst)] = c
+    net = _Network.read(root)
+    layout = _lay_out(net, route_edges, net_file)
+    edge_to = {e.attrib["id"]: e.get("to") for e in root.iter("edge") if not e.get("function")}
+    nodes = {j.attrib["id"]: j for j in root.iter("junction")}
+    lights = [
+        RouteLight(tls_id=nodes[edge_to[eid] or ""].attrib["id"], stop_line_m=layout.end[eid])
+        for eid in route_edges[:-1]
+        if nodes[edge_to[eid] or ""].get("type") == "traffic_light"
+    ]
+    crossings = _route_crossings(root, route_edges, edge_to, nodes, layout)
+    return RouteGeometry(
+        edges=tuple(route_edges),
+        edge_start_m=tuple(layout.starts),
+        length_m=layout.length_m,
+        zone_start_m=tuple(layout.zone_start),
+        zone_limit_mps=tuple(layout.zone_limit),
+        lights=tuple(lights),
+        crossings=tuple(crossings),
+    )
 
-    starts: list[float] = []
-    zone_start: list[float] = []
-    zone_limit: list[float] = []
+
+@dataclass
+class _Network:
+    """What the route layout needs from a network file."""
+
+    lanes: dict[str, tuple[float, float]]  # lane -> (length, speed limit)
+    edge_lane: dict[str, str]  # normal edge -> its vehicle lane
+    conns: dict[tuple[str, str], ET.Element]  # (edge, next edge) -> connection with a via lane
+    via_next: dict[str, str]  # internal lane -> the next internal lane
+
+    @classmethod
+    def read(cls, root: ET.Element) -> _Network:
+        edge_lane: dict[str, str] = {}
+        for edge in root.iter("edge"):
+            if edge.get("function"):
+                continue
+            for lane in edge.iter("lane"):
+                if "pedestrian" not in (lane.get("allow") or "").split():
+                    edge_lane[edge.attrib["id"]] = lane.attrib["id"]  # the vehicle lane
+        conns: dict[tuple[str, str], ET.Element] = {}
+        via_next: dict[str, str] = {}
+        for c in root.iter("connection"):
+            src, dst = c.attrib["from"], c.attrib["to"]
+            if src.startswith(":"):
+                if c.get("via"):
+                    via_next[f"{src}_{c.attrib['fromLane']}"] = c.attrib["via"]
+                continue
+            if dst in edge_lane and c.get("via"):
+                lane_from = f"{src}_{c.attrib['fromLane']}"
+                if lane_from == edge_lane.get(src):
+                    conns[(src, dst)] = c
+        return cls(_lane_lengths(root), edge_lane, conns, via_next)
+
+
+@dataclass
+class _Layout:
+    """Positions along the route [m]: edge starts and ends, speed zones, total length."""
+
+    starts: list[float]
+    end: dict[str, float]
+    zone_start: list[float]
+    zone_limit: list[float]
+    length_m: float
+
+
+def _lay_out(net: _Network, route_edges: tuple[str, ...], net_file: Path) -> _Layout:
+    """Walk the route edge by edge, through the junctions' internal lanes."""
+    layout = _Layout([], {}, [], [], 0.0)
     pos = 0.0
-    end_of_edge: dict[str, float] = {}
     for i, eid in enumerate(route_edges):
-        if eid not in edge_lane:
+        if eid not in net.edge_lane:
             raise ValueError(f"route edge {eid!r} not found in {net_file}")
-        length, speed = lanes[edge_lane[eid]]
-        starts.append(pos)
-        if not zone_limit or zone_limit[-1] != speed:
-            zone_start.append(pos)
-            zone_limit.append(speed)
+        length, speed = net.lanes[net.edge_lane[eid]]
+        layout.starts.append(pos)
+        if not layout.zone_limit or layout.zone_limit[-1] != speed:
+            layout.zone_start.append(pos)
+            layout.zone_limit.append(speed)
         pos += length
-        end_of_edge[eid] = pos
+        layout.end[eid] = pos
         if i + 1 < len(route_edges):
-            conn = conns.get((eid, route_edges[i + 1]))
+            conn = net.conns.get((eid, route_edges[i + 1]))
             if conn is None:
                 raise ValueError(f"no connection {eid} -> {route_edges[i + 1]} in {net_file}")
             via: str | None = conn.attrib["via"]
-            nxt_speed = lanes[edge_lane[route_edges[i + 1]]][1]
+            nxt_speed = net.lanes[net.edge_lane[route_edges[i + 1]]][1]
             if nxt_speed < speed:  # the lower limit starts at the junction
-                zone_start.append(pos)
-                zone_limit.append(nxt_speed)
+                layout.zone_start.append(pos)
+                layout.zone_limit.append(nxt_speed)
             while via:
-                pos += lanes[via][0]
-                via = via_next.get(via)
+                pos += net.lanes[via][0]
+                via = net.via_next.get(via)
+    layout.length_m = pos
+    return layout
 
-    lights = []
+
+def _route_crossings(
+    root: ET.Element,
+    route_edges: tuple[str, ...],
+    edge_to: dict[str, str | None],
+    nodes: dict[str, ET.Element],
+    layout: _Layout,
+) -> list[RouteCrossing]:
+    """The pedestrian crossings over the route, ordered along it."""
     crossings = []
-    nodes = {j.attrib["id"]: j for j in root.iter("junction")}
-    edge_to = {e.attrib["id"]: e.get("to") for e in root.iter("edge") if not e.get("function")}
-    for eid in route_edges[:-1]:
-        node = nodes[edge_to[eid] or ""]
-        if node.get("type") == "traffic_light":
-            lights.append(RouteLight(tls_id=node.attrib["id"], stop_line_m=end_of_edge[eid]))
     for edge in root.iter("edge"):
         if edge.get("function") != "crossing":
             continue
@@ -151,18 +198,9 @@ def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGe
             RouteCrossing(
                 crossing_edge=cid,
                 walkingareas=tuple(walk),
-                stop_line_m=end_of_edge[route_in[0]],
+                stop_line_m=layout.end[route_in[0]],
                 signalized=nodes[node_id].get("type") == "traffic_light",
-                end_m=starts[route_edges.index(route_in[0]) + 1],
+                end_m=layout.starts[route_edges.index(route_in[0]) + 1],
             )
         )
-    crossings.sort(key=lambda c: c.stop_line_m)
-    return RouteGeometry(
-        edges=tuple(route_edges),
-        edge_start_m=tuple(starts),
-        length_m=pos,
-        zone_start_m=tuple(zone_start),
-        zone_limit_mps=tuple(zone_limit),
-        lights=tuple(lights),
-        crossings=tuple(crossings),
-    )
+    return sorted(crossings, key=lambda c: c.stop_line_m)
