@@ -56,7 +56,7 @@ log = logging.getLogger(__name__)
 _EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER)
 _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
-ENTRY_CLEAR_AFTER_S = 10  # [s] waiting for a gap before the entry stretch is cleared
+ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
 _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
 _HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
@@ -466,7 +466,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             api.simulationStep()
             if EGO_ID in api.simulation.getDepartedIDList():
                 break
-            if waited == ENTRY_CLEAR_AFTER_S:
+            if waited and waited % ENTRY_CLEAR_AFTER_S == 0:
                 self._clear_entry()
         else:
             raise RuntimeError(
@@ -496,7 +496,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         for vid in api.lane.getLastStepVehicleIDs(lane):
             if vid != EGO_ID and api.vehicle.getLanePosition(vid) < ENTRY_CLEAR_M:
                 api.vehicle.remove(vid)
-        log.debug("cleared the ego's entry stretch after %d s of waiting", ENTRY_CLEAR_AFTER_S)
+        log.debug("cleared the ego's entry stretch after %d s without a gap", ENTRY_CLEAR_AFTER_S)
 
     def _apply_schedule(self, now_s: float) -> None:
         ep = self._episode()
