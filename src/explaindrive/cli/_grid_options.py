@@ -26,6 +26,10 @@ RayOption = Annotated[bool, typer.Option("--ray", help="Run the episodes on a lo
 RayAddressOption = Annotated[
     str | None, typer.Option("--ray-address", help="Run the episodes on this Ray cluster.")
 ]
+TrafficOption = Annotated[str, typer.Option("--traffic", help="Traffic levels, comma-separated.")]
+JsonOption = Annotated[
+    Path | None, typer.Option("--json", help="Write every episode and the aggregates here.")
+]
 MaxStepsOption = Annotated[
     int, typer.Option("--max-steps", min=1, help="Step limit per episode [s].")
 ]

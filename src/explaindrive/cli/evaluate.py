@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -13,14 +13,19 @@ from explaindrive.cli._errors import error_line
 from explaindrive.cli._grid_options import (
     ComfortPolicyOption,
     FastPolicyOption,
+    JsonOption,
     MaxStepsOption,
     RayAddressOption,
     RayOption,
     ShieldOption,
+    TrafficOption,
     WorkersOption,
     check_ray_target,
 )
 from explaindrive.evaluation.paper import PAPER_SEEDS, PAPER_TRAFFIC_LEVELS
+
+if TYPE_CHECKING:
+    from explaindrive.evaluation.spec import PolicySpec, RunPlan
 
 console = Console()
 err_console = Console(stderr=True)
@@ -37,31 +42,35 @@ def progress_bar() -> Progress:
     )  # fmt: skip
 
 
+PolicyArgument = Annotated[
+    str, typer.Argument(help="fast | comfort | merged | krauss | idm | a policy .pt / run dir.")
+]
+SeedsOption = Annotated[str, typer.Option("--seeds", help="Seeds: 0-4 or 0,3,7.")]
+StopScheduleOption = Annotated[
+    str | None, typer.Option("--stop-schedule", help="Stop injections [s], e.g. 60-75,150-165.")
+]
+CommandsOption = Annotated[
+    str | None,
+    typer.Option(
+        "--commands", help='Command segments [s], e.g. "fast:0-90,stop:90-110,comfort:110-".'
+    ),
+]
+FiguresOption = Annotated[
+    Path | None, typer.Option("--figures", help="Write PNG figures into this directory.")
+]
+EpisodesOption = Annotated[
+    bool, typer.Option("--episodes/--no-episodes", help="Also print one row per episode.")
+]
+
+
 def evaluate_command(
-    policy: Annotated[
-        str,
-        typer.Argument(help="fast | comfort | merged | krauss | idm | a policy .pt / run dir."),
-    ],
-    seeds: Annotated[str, typer.Option("--seeds", help="Seeds: 0-4 or 0,3,7.")] = DEFAULT_SEEDS,
-    traffic: Annotated[
-        str, typer.Option("--traffic", help="Traffic levels, comma-separated.")
-    ] = DEFAULT_TRAFFIC,
-    stop_schedule: Annotated[
-        str | None,
-        typer.Option("--stop-schedule", help="Stop injections [s], e.g. 60-75,150-165."),
-    ] = None,
-    commands: Annotated[
-        str | None,
-        typer.Option(
-            "--commands", help='Command segments [s], e.g. "fast:0-90,stop:90-110,comfort:110-".'
-        ),
-    ] = None,
-    json_file: Annotated[
-        Path | None, typer.Option("--json", help="Write every episode and the aggregates here.")
-    ] = None,
-    figures: Annotated[
-        Path | None, typer.Option("--figures", help="Write PNG figures into this directory.")
-    ] = None,
+    policy: PolicyArgument,
+    seeds: SeedsOption = DEFAULT_SEEDS,
+    traffic: TrafficOption = DEFAULT_TRAFFIC,
+    stop_schedule: StopScheduleOption = None,
+    commands: CommandsOption = None,
+    json_file: JsonOption = None,
+    figures: FiguresOption = None,
     workers: WorkersOption = None,
     ray: RayOption = False,
     ray_address: RayAddressOption = None,
@@ -69,16 +78,9 @@ def evaluate_command(
     fast_policy: FastPolicyOption = None,
     comfort_policy: ComfortPolicyOption = None,
     shield: ShieldOption = True,
-    episodes: Annotated[
-        bool, typer.Option("--episodes/--no-episodes", help="Also print one row per episode.")
-    ] = True,
+    episodes: EpisodesOption = True,
 ) -> None:
     """Evaluate a policy or a SUMO baseline; prints Markdown tables in the paper's layout."""
-    from explaindrive.agent.checkpoint import CheckpointError
-    from explaindrive.evaluation import figures as figs
-    from explaindrive.evaluation import tables
-    from explaindrive.evaluation.aggregate import summarize
-    from explaindrive.evaluation.runner import run_grid
     from explaindrive.evaluation.schema import run_document, write_json
     from explaindrive.evaluation.spec import (
         SpecError,
@@ -102,13 +104,28 @@ def evaluate_command(
     if (problem := check_ray_target(ray, ray_address)) is not None:
         err_console.print(error_line(problem))
         raise typer.Exit(2)
+    records = _run(plan, workers, ray, ray_address)
+    _print_tables(plan.name, spec, records, episodes)
+    if json_file is not None:
+        write_json(json_file, [run_document(plan.name, records)])
+        err_console.print(f"wrote {json_file}")
+    if figures is not None:
+        for path in _write_figures(plan, spec, records, figures):
+            err_console.print(f"wrote {path}")
+
+
+def _run(plan: RunPlan, workers: int | None, ray: bool, ray_address: str | None) -> list[Any]:
+    """Run the grid with a progress bar; a policy that cannot load or an episode that fails
+    ends the command with one line."""
+    from explaindrive.agent.checkpoint import CheckpointError
+    from explaindrive.evaluation.runner import run_grid
 
     n = len(plan.episodes)
     err_console.print(f"evaluating [bold]{plan.name}[/bold]: {n} episode(s)")
     try:
         with progress_bar() as bar:
             task = bar.add_task(plan.name, total=n)
-            records = run_grid(
+            return run_grid(
                 plan.episodes, workers=workers, use_ray=ray, ray_address=ray_address,
                 progress=lambda done, _total: bar.update(task, completed=done),
             )  # fmt: skip
@@ -116,9 +133,15 @@ def evaluate_command(
         err_console.print(error_line(exc))
         raise typer.Exit(1) from None
 
-    summary = summarize(plan.name, [(r.spec.traffic_level, r.result) for r in records])
+
+def _print_tables(name: str, spec: PolicySpec, records: list[Any], episodes: bool) -> None:
+    """The paper's table, per level, safety, the shield's share and (optionally) episodes."""
+    from explaindrive.evaluation import tables
+    from explaindrive.evaluation.aggregate import summarize
+
+    summary = summarize(name, [(r.spec.traffic_level, r.result) for r in records])
     out = Console(highlight=False, markup=False, soft_wrap=True)
-    out.print(f"## {plan.name}\n")
+    out.print(f"## {name}\n")
     out.print(tables.paper_table([summary]) + "\n")
     out.print(tables.level_table([summary]) + "\n")
     out.print(tables.safety_table([summary]) + "\n")
@@ -130,30 +153,34 @@ def evaluate_command(
         out.print(tables.episode_table(
             [(r.spec.seed, r.spec.traffic_level, r.result) for r in records]
         ))  # fmt: skip
-    if json_file is not None:
-        write_json(json_file, [run_document(plan.name, records)])
-        err_console.print(f"wrote {json_file}")
-    if figures is not None:
-        written = [
-            figs.plot_speed_bands(
-                {plan.name: [r.speeds_mps for r in records]}, figures / "speed_profile.png",
-                stop_intervals={plan.name: plan.stop_intervals},
-            ),
-        ]  # fmt: skip
-        if plan.episodes[0].schedule:
-            first = records[0]
-            written.append(figs.plot_command_profile(
-                first.speeds_mps, first.commands, figures / "command_profile.png",
-                title=f"{plan.name}: seed {first.spec.seed}, traffic {first.spec.traffic_level:g}",
-            ))  # fmt: skip
-        for policy_file in spec.paths[:1] if spec.kind == "agent" else ():
-            log_csv = Path(policy_file).parent / "episodes.csv"
-            if log_csv.is_file():
-                written.append(
-                    figs.plot_training_curves({spec.name: log_csv}, figures / "training_curve.png")
-                )
-        for path in written:
-            err_console.print(f"wrote {path}")
+
+
+def _write_figures(
+    plan: RunPlan, spec: PolicySpec, records: list[Any], figures: Path
+) -> list[Path]:
+    """Speed bands, the first episode's command profile, and the training curve of a policy
+    that sits in a training run directory."""
+    from explaindrive.evaluation import figures as figs
+
+    written = [
+        figs.plot_speed_bands(
+            {plan.name: [r.speeds_mps for r in records]}, figures / "speed_profile.png",
+            stop_intervals={plan.name: plan.stop_intervals},
+        ),
+    ]  # fmt: skip
+    if plan.episodes[0].schedule:
+        first = records[0]
+        written.append(figs.plot_command_profile(
+            first.speeds_mps, first.commands, figures / "command_profile.png",
+            title=f"{plan.name}: seed {first.spec.seed}, traffic {first.spec.traffic_level:g}",
+        ))  # fmt: skip
+    for policy_file in spec.paths[:1] if spec.kind == "agent" else ():
+        log_csv = Path(policy_file).parent / "episodes.csv"
+        if log_csv.is_file():
+            written.append(
+                figs.plot_training_curves({spec.name: log_csv}, figures / "training_curve.png")
+            )
+    return written
 
 
 def register(app: typer.Typer) -> None:

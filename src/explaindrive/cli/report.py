@@ -5,7 +5,7 @@ from __future__ import annotations
 import shlex
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -13,95 +13,80 @@ from explaindrive.cli._errors import error_line
 from explaindrive.cli._grid_options import (
     ComfortPolicyOption,
     FastPolicyOption,
+    JsonOption,
     MaxStepsOption,
     RayAddressOption,
     RayOption,
     ShieldOption,
+    TrafficOption,
     WorkersOption,
     check_ray_target,
 )
 from explaindrive.cli.evaluate import DEFAULT_TRAFFIC, err_console, progress_bar
 from explaindrive.evaluation.spec import POLICY_NAMES
 
+if TYPE_CHECKING:
+    from explaindrive.evaluation.report import ReportPlan
+
+
+ALL_POLICIES = ",".join(POLICY_NAMES)
+OutOption = Annotated[Path, typer.Option("--out", help="The results document to write.")]
+FigureDirOption = Annotated[
+    Path | None,
+    typer.Option("--figures", help="Figure directory (default: figures/ next to --out)."),
+]
+EpisodesPerCellOption = Annotated[
+    int, typer.Option("--episodes-per-cell", min=1, help="Seeds per traffic level (paper: 5).")
+]
+PoliciesOption = Annotated[
+    str, typer.Option("--policies", help="Subset of " + ",".join(POLICY_NAMES) + ".")
+]
+RunsOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--runs",
+        help="Training runs (<dir>/fast, <dir>/comfort) for the curves "
+        "(default: the shipped policies' training logs).",
+    ),
+]
+SeedTableOption = Annotated[
+    list[Path] | None,
+    typer.Option("--seed-table", help="A seeds.md of train --seeds to include (repeatable)."),
+]
+
 
 def report_command(
-    out: Annotated[Path, typer.Option("--out", help="The results document to write.")] = Path(
-        "docs/results.md"
-    ),
-    figures: Annotated[
-        Path | None,
-        typer.Option("--figures", help="Figure directory (default: figures/ next to --out)."),
-    ] = None,
-    episodes_per_cell: Annotated[
-        int,
-        typer.Option("--episodes-per-cell", min=1, help="Seeds per traffic level (paper: 5)."),
-    ] = 5,
-    traffic: Annotated[
-        str, typer.Option("--traffic", help="Traffic levels, comma-separated.")
-    ] = DEFAULT_TRAFFIC,
-    policies: Annotated[
-        str, typer.Option("--policies", help="Subset of " + ",".join(POLICY_NAMES) + ".")
-    ] = ",".join(POLICY_NAMES),
+    out: OutOption = Path("docs/results.md"),
+    figures: FigureDirOption = None,
+    episodes_per_cell: EpisodesPerCellOption = 5,
+    traffic: TrafficOption = DEFAULT_TRAFFIC,
+    policies: PoliciesOption = ALL_POLICIES,
     fast_policy: FastPolicyOption = None,
     comfort_policy: ComfortPolicyOption = None,
     shield: ShieldOption = True,
-    runs_dir: Annotated[
-        Path | None,
-        typer.Option(
-            "--runs",
-            help="Training runs (<dir>/fast, <dir>/comfort) for the curves "
-            "(default: the shipped policies' training logs).",
-        ),
-    ] = None,
-    json_file: Annotated[
-        Path | None, typer.Option("--json", help="Also write every episode and aggregate here.")
-    ] = None,
+    runs_dir: RunsOption = None,
+    json_file: JsonOption = None,
     workers: WorkersOption = None,
     ray: RayOption = False,
     ray_address: RayAddressOption = None,
     max_steps: MaxStepsOption = 1000,
-    seed_tables: Annotated[
-        list[Path] | None,
-        typer.Option("--seed-table", help="A seeds.md of train --seeds to include (repeatable)."),
-    ] = None,
+    seed_tables: SeedTableOption = None,
 ) -> None:
     """Evaluate the policies and baselines and rewrite the results document and figures."""
     from explaindrive.agent.checkpoint import CheckpointError
-    from explaindrive.agent.controller import shipped_training_log
-    from explaindrive.evaluation.report import parse_policy_list, plan_report, run_report
-    from explaindrive.evaluation.spec import SpecError, parse_levels
+    from explaindrive.evaluation.report import run_report
 
-    if (problem := check_ray_target(ray, ray_address)) is not None:
-        err_console.print(error_line(problem))
-        raise typer.Exit(2)
-    missing = [p for p in seed_tables or [] if not p.is_file()]
-    if missing:
-        err_console.print(error_line(f"seed table not found: {missing[0]}"))
-        raise typer.Exit(2)
-    try:
-        names = parse_policy_list(policies)
-        plan = plan_report(
-            names, tuple(range(episodes_per_cell)), parse_levels(traffic),
-            fast_path=fast_policy, comfort_path=comfort_policy, max_steps=max_steps,
-            shield=shield,
-        )  # fmt: skip
-    except SpecError as exc:
-        err_console.print(error_line(exc))
-        raise typer.Exit(2) from None
+    plan = _plan(policies, episodes_per_cell, traffic, fast_policy, comfort_policy, max_steps,
+                 shield, ray, ray_address, seed_tables or [])  # fmt: skip
     n = sum(len(run.episodes) for run in plan.runs)
     err_console.print(f"report: {len(plan.runs)} runs, {n} episodes")
-    command_line = "explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-    training = {
-        name: (runs_dir / name / "episodes.csv" if runs_dir else shipped_training_log(name))
-        for name in names
-        if name in ("fast", "comfort")
-    }
     try:
         with progress_bar() as bar:
             task = bar.add_task("episodes", total=n)
             result = run_report(
-                plan, out, figures_dir=figures, training_runs=training, json_file=json_file,
-                command_line=command_line, workers=workers, use_ray=ray, ray_address=ray_address,
+                plan, out, figures_dir=figures, training_runs=_training_logs(plan, runs_dir),
+                json_file=json_file, workers=workers, use_ray=ray, ray_address=ray_address,
+                command_line="explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
                 progress=lambda done, _total: bar.update(task, completed=done),
                 seed_tables=seed_tables or [],
             )  # fmt: skip
@@ -112,6 +97,43 @@ def report_command(
     out.write_text(result.markdown, encoding="utf-8")
     for path in (out, *result.figures):
         err_console.print(f"wrote {path}")
+
+
+def _plan(
+    policies: str, episodes_per_cell: int, traffic: str, fast_policy: Path | None,
+    comfort_policy: Path | None, max_steps: int, shield: bool, ray: bool,
+    ray_address: str | None, seed_tables: list[Path],
+) -> ReportPlan:  # fmt: skip
+    """The report's runs; a bad option ends the command with one line and status 2."""
+    from explaindrive.evaluation.report import parse_policy_list, plan_report
+    from explaindrive.evaluation.spec import SpecError, parse_levels
+
+    problem = check_ray_target(ray, ray_address)
+    missing = [p for p in seed_tables if not p.is_file()]
+    if problem is None and missing:
+        problem = f"seed table not found: {missing[0]}"
+    try:
+        if problem is not None:
+            raise SpecError(problem)
+        return plan_report(
+            parse_policy_list(policies), tuple(range(episodes_per_cell)), parse_levels(traffic),
+            fast_path=fast_policy, comfort_path=comfort_policy, max_steps=max_steps,
+            shield=shield,
+        )  # fmt: skip
+    except SpecError as exc:
+        err_console.print(error_line(exc))
+        raise typer.Exit(2) from None
+
+
+def _training_logs(plan: ReportPlan, runs_dir: Path | None) -> dict[str, Path]:
+    """``episodes.csv`` of each agent: from ``runs_dir``, else the shipped training logs."""
+    from explaindrive.agent.controller import shipped_training_log
+
+    return {
+        name: (runs_dir / name / "episodes.csv" if runs_dir else shipped_training_log(name))
+        for name in plan.policies
+        if name in ("fast", "comfort")
+    }
 
 
 def register(app: typer.Typer) -> None:
