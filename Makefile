@@ -26,7 +26,7 @@ system-deps:
 	fi
 
 demo: install
-	$(BIN)/explaindrive ride
+	$(BIN)/explaindrive ride --force
 
 test: dev-install system-deps
 	$(BIN)/python -m pytest
