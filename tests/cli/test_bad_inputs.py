@@ -76,7 +76,7 @@ def test_ride_script_that_is_not_utf8(tmp_path: Path) -> None:
         (["--traffic", "nan"], "traffic level must be a finite number > 0, got nan"),
         (
             ["--traffic", "99"],
-            "traffic level 99 is above the busiest level the scenario is built for",
+            "traffic level must be at most 1.75, got 99",
         ),
     ],
 )
@@ -89,8 +89,8 @@ def test_train_refuses_a_traffic_level_the_scenario_cannot_carry(tmp_path: Path)
     args = ("train", "--mode", "fast", "--set", "traffic_levels=[99]", "--no-progress")
     line = one_error_line(run(*args, "--out", "run", cwd=tmp_path))
     assert line == (
-        "error: invalid training config: traffic_levels: 99 is above the scenario's busiest "
-        "level 1.5"
+        "error: invalid training config: traffic_levels: traffic level must be at most 1.75, "
+        "got 99: on a busier road the ego cannot enter"
     )
     assert not (tmp_path / "run").exists()  # refused when read: no workers, no run folder
 

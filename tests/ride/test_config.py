@@ -11,8 +11,8 @@ from explaindrive.ride.config import RideConfig
     ("settings", "message"),
     [
         ({"max_steps": 0}, "max_steps must be > 0, got 0"),
-        ({"seed": -1}, r"seed must be in \[0, 2\*\*31\), got -1"),
-        ({"seed": 2**31}, r"seed must be in \[0, 2\*\*31\)"),
+        ({"seed": -1}, r"seed must be an integer in \[0, 2\*\*31\), got -1"),
+        ({"seed": 2**31}, r"seed must be an integer in \[0, 2\*\*31\)"),
         (
             {"interpret_deadline_s": -0.5},
             "interpret_deadline_s must be a finite number >= 0, got -0.5",
@@ -29,7 +29,7 @@ from explaindrive.ride.config import RideConfig
         ({"traffic_level": float("nan")}, "traffic level must be a finite number > 0, got nan"),
         (
             {"traffic_level": 99.0},
-            "traffic level 99 is above the busiest level the scenario is built for \\(1.5\\)",
+            "traffic level must be at most 1.75, got 99: on a busier road the ego cannot enter",
         ),
         ({"backend": "gpt"}, "unknown language backend 'gpt'; choose one of: embedded, openai"),
         ({"traffic_level": 0.0}, "traffic level must be > 0"),

@@ -23,8 +23,7 @@ from typing import Any
 import yaml
 
 from explaindrive.commands import Command
-from explaindrive.env.config import TRAFFIC_LEVELS
-from explaindrive.sim.scenario.layout import validate_traffic_level
+from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS, validate_traffic_level
 
 _NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
@@ -95,7 +94,7 @@ class TrainConfig:
     n_step: int = 1
     """Steps summed in each bootstrapped return (1: the paper's one-step target)."""
 
-    traffic_levels: tuple[float, ...] = (0.5, 0.75, 1.0, 1.25, 1.5)
+    traffic_levels: tuple[float, ...] = TRAFFIC_LEVELS
     """Traffic levels sampled uniformly per episode (1.0 = 900 veh/h on the main road)."""
     stop_gap_s: tuple[float, float] = (15.0, 60.0)
     """Range [s] of the random time before each injected stop command (even episodes)."""
@@ -241,9 +240,6 @@ def _problems(c: TrainConfig) -> typing.Iterator[str]:
             validate_traffic_level(level)
         except ValueError as exc:
             yield f"traffic_levels: {exc}"
-        else:  # a busier road stays blocked: the ego cannot enter, no episode starts
-            if level > (busiest := max(TRAFFIC_LEVELS)):
-                yield f"traffic_levels: {level:g} is above the scenario's busiest level {busiest:g}"
     for name in ("stop_gap_s", "stop_duration_s"):
         lo, hi = getattr(c, name)
         if not 0 < lo <= hi:

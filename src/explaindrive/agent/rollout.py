@@ -30,6 +30,7 @@ from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.schedule import EpisodePlan, plan_episode
 from explaindrive.agent.shield import runtime_mask, training_mask
+from explaindrive.sim.scenario.layout import SEED_LIMIT
 
 log = logging.getLogger(__name__)
 
@@ -42,7 +43,7 @@ MAX_RESET_ATTEMPTS = 5
 
 def reseed(seed: int, attempt: int) -> int:
     """Replacement seed for an episode whose env could not start with ``seed``."""
-    return int(np.random.default_rng([seed, attempt, 7]).integers(0, 2**31 - 1))
+    return int(np.random.default_rng([seed, attempt, 7]).integers(0, SEED_LIMIT - 1))
 
 
 def make_urban_drive_env(max_steps: int | None = None) -> gym.Env:

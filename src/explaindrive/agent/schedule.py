@@ -15,6 +15,7 @@ import numpy as np
 
 from explaindrive.agent.config import SEED_POOL_BASE, TrainConfig
 from explaindrive.commands import Command
+from explaindrive.sim.scenario.layout import SEED_LIMIT
 
 
 @dataclass(frozen=True)
@@ -71,7 +72,7 @@ def plan_episode(config: TrainConfig, index: int) -> EpisodePlan:
         raise ValueError(f"episode index must be >= 0, got {index}")
     rng = np.random.default_rng([config.seed, index])
     if config.seed_pool is None:
-        seed = int(rng.integers(0, 2**31 - 1))
+        seed = int(rng.integers(0, SEED_LIMIT - 1))
     else:
         seed = SEED_POOL_BASE + int(rng.integers(config.seed_pool))
     level = float(config.traffic_levels[int(rng.integers(len(config.traffic_levels)))])

@@ -22,7 +22,8 @@ from explaindrive.cli._grid_options import (
     WorkersOption,
     check_ray_target,
 )
-from explaindrive.evaluation.paper import PAPER_SEEDS, PAPER_TRAFFIC_LEVELS
+from explaindrive.evaluation.paper import PAPER_SEEDS
+from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 if TYPE_CHECKING:
     from explaindrive.evaluation.spec import PolicySpec, RunPlan
@@ -31,7 +32,7 @@ console = Console()
 err_console = Console(stderr=True)
 
 DEFAULT_SEEDS = f"{PAPER_SEEDS[0]}-{PAPER_SEEDS[-1]}"
-DEFAULT_TRAFFIC = ",".join(f"{x:g}" for x in PAPER_TRAFFIC_LEVELS)
+DEFAULT_TRAFFIC = ",".join(f"{x:g}" for x in TRAFFIC_LEVELS)
 
 
 def progress_bar() -> Progress:

@@ -188,8 +188,8 @@ def _train_seeds(
         evaluate_seeds,
         train_seeds,
     )
-    from explaindrive.evaluation.paper import PAPER_TRAFFIC_LEVELS
     from explaindrive.evaluation.spec import SpecError, parse_seeds
+    from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
     try:
         if seed is not None:
@@ -204,7 +204,7 @@ def _train_seeds(
     for s, code in codes.items():
         status = "done" if code == 0 else f"failed (exit {code}, see {out}/seed-{s}.log)"
         console.print(f"seed {s}: {status}")
-    results = evaluate_seeds(out, seeds, parse_seeds(DEFAULT_EVAL_SEEDS), PAPER_TRAFFIC_LEVELS,
+    results = evaluate_seeds(out, seeds, parse_seeds(DEFAULT_EVAL_SEEDS), TRAFFIC_LEVELS,
                              DEFAULT_EVAL_STOPS)  # fmt: skip
     console.print((out / "seeds.md").read_text(encoding="utf-8"), markup=False)
     if not results or any(code != 0 for code in codes.values()):

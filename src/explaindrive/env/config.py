@@ -10,7 +10,6 @@ from typing import Any
 
 from explaindrive.sim.scenario.layout import validate_traffic_level
 
-TRAFFIC_LEVELS: tuple[float, ...] = (0.5, 0.75, 1.0, 1.25, 1.5)
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
 

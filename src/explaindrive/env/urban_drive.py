@@ -48,7 +48,7 @@ from explaindrive.sim.scenario.files import (
     ScenarioFiles,
     default_scenario,
 )
-from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES
+from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES, SEED_LIMIT, validate_seed
 from explaindrive.sim.sumo_home import sumo_binary
 
 log = logging.getLogger(__name__)
@@ -212,9 +212,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         super().reset(seed=seed)
         opts = ResetOptions.parse(options)
         level = opts.traffic_level if opts.traffic_level is not None else self.config.traffic_level
-        sumo_seed = seed if seed is not None else int(self.np_random.integers(0, 2**31 - 1))
-        if isinstance(sumo_seed, bool) or not 0 <= int(sumo_seed) < 2**31:
-            raise ValueError(f"seed must be an integer in [0, 2**31), got {seed!r}")
+        sumo_seed = seed if seed is not None else int(self.np_random.integers(0, SEED_LIMIT - 1))
+        validate_seed(sumo_seed)
         try:
             self._conn.start_or_load(self._sumo_args(level, int(sumo_seed)))
             self._restore_warm_state(level, int(sumo_seed))

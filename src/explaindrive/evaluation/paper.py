@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-PAPER_TRAFFIC_LEVELS: tuple[float, ...] = (0.5, 0.75, 1.0, 1.25, 1.5)
+from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
+
 PAPER_SEEDS: tuple[int, ...] = (0, 1, 2, 3, 4)
 PAPER_STOP_INTERVALS_S: tuple[tuple[float, float], ...] = ((60.0, 75.0), (150.0, 165.0))
 """Stop injections used for the "with stops" speed profiles [s from the episode start]."""
@@ -21,7 +22,7 @@ class PaperRow:
 
     Attributes:
         policy: ``fast`` or ``comfort``.
-        steps_by_level: mean SUMO steps per traffic level (keys: :data:`PAPER_TRAFFIC_LEVELS`).
+        steps_by_level: mean SUMO steps per traffic level (keys: :data:`TRAFFIC_LEVELS`).
         speed_by_level_mps: mean speed per traffic level [m/s].
         mean_speed_mps: mean speed over the 25 episodes [m/s].
         avg_headway_s: average time headway [s].
@@ -45,9 +46,9 @@ class PaperRow:
 PAPER_RESULTS: dict[str, PaperRow] = {
     "fast": PaperRow(
         policy="fast",
-        steps_by_level=dict(zip(PAPER_TRAFFIC_LEVELS, (253, 323, 386, 401, 397), strict=True)),
+        steps_by_level=dict(zip(TRAFFIC_LEVELS, (253, 323, 386, 401, 397), strict=True)),
         speed_by_level_mps=dict(
-            zip(PAPER_TRAFFIC_LEVELS, (6.087, 4.767, 3.982, 3.825, 3.879), strict=True)
+            zip(TRAFFIC_LEVELS, (6.087, 4.767, 3.982, 3.825, 3.879), strict=True)
         ),
         mean_speed_mps=4.508,
         avg_headway_s=2.998,
@@ -58,9 +59,9 @@ PAPER_RESULTS: dict[str, PaperRow] = {
     ),
     "comfort": PaperRow(
         policy="comfort",
-        steps_by_level=dict(zip(PAPER_TRAFFIC_LEVELS, (257, 333, 398, 416, 405), strict=True)),
+        steps_by_level=dict(zip(TRAFFIC_LEVELS, (257, 333, 398, 416, 405), strict=True)),
         speed_by_level_mps=dict(
-            zip(PAPER_TRAFFIC_LEVELS, (5.996, 4.617, 3.869, 3.699, 3.800), strict=True)
+            zip(TRAFFIC_LEVELS, (5.996, 4.617, 3.869, 3.699, 3.800), strict=True)
         ),
         mean_speed_mps=4.396,
         avg_headway_s=6.373,

@@ -22,9 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from explaindrive.commands import COMMAND_LABELS, Command
-from explaindrive.sim.scenario.layout import validate_traffic_level
+from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
 
-MAX_SEED = 2**31  # exclusive; SUMO's seed range
 BASELINES: tuple[str, ...] = ("krauss", "idm")
 AGENTS: tuple[str, ...] = ("fast", "comfort")
 MERGED = "merged"
@@ -106,8 +105,10 @@ def _seed(token: str, text: str) -> int:
         value = int(token)
     except ValueError:
         raise SpecError(f"seed {token!r} in {text!r} is not an integer") from None
-    if not 0 <= value < MAX_SEED:
-        raise SpecError(f"seed {value} in {text!r} is outside [0, 2**31)")
+    try:
+        validate_seed(value)
+    except ValueError:
+        raise SpecError(f"seed {value} in {text!r} is outside [0, 2**31)") from None
     return value
 
 

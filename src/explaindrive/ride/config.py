@@ -5,11 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from explaindrive.env.config import TRAFFIC_LEVELS
 from explaindrive.language.backends import check_backend
-from explaindrive.sim.scenario.layout import validate_traffic_level
-
-MAX_TRAFFIC_LEVEL = max(TRAFFIC_LEVELS)  # the busiest level the scenario is built for
+from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
 
 
 @dataclass(frozen=True, slots=True)
@@ -17,7 +14,7 @@ class RideConfig:
     """Settings of :class:`~explaindrive.ride.session.RideSession`.
 
     Attributes:
-        traffic_level: demand scale, in (0, 1.5] (1.0 = 900 veh/h on the main road).
+        traffic_level: demand scale, in (0, 1.75] (1.0 = 900 veh/h on the main road).
         seed: simulation seed.
         max_steps: longest ride [steps of 1 s].
         backend: language backend (``embedded`` or ``openai``).
@@ -48,15 +45,9 @@ class RideConfig:
 
     def __post_init__(self) -> None:
         validate_traffic_level(self.traffic_level)
-        if self.traffic_level > MAX_TRAFFIC_LEVEL:
-            raise ValueError(
-                f"traffic level {self.traffic_level:g} is above the busiest level the scenario "
-                f"is built for ({MAX_TRAFFIC_LEVEL:g}); the ego could not enter the road"
-            )
+        validate_seed(self.seed)
         if self.max_steps <= 0:
             raise ValueError(f"max_steps must be > 0, got {self.max_steps}")
-        if not 0 <= self.seed < 2**31:
-            raise ValueError(f"seed must be in [0, 2**31), got {self.seed}")
         for name in (
             "explanation_cooldown_s",
             "interpret_deadline_s",

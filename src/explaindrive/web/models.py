@@ -6,12 +6,14 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from explaindrive.env.config import TRAFFIC_LEVELS
-from explaindrive.sim.scenario.layout import validate_traffic_level
+from explaindrive.sim.scenario.layout import (
+    MAX_TRAFFIC_LEVEL,
+    SEED_LIMIT,
+    validate_traffic_level,
+)
 
 MAX_TEXT_CHARS = 300  # a spoken request is a sentence or two
 MAX_RIDE_STEPS = 1800  # [s] half an hour of driving
-MAX_TRAFFIC_LEVEL = max(TRAFFIC_LEVELS)  # the busiest level the scenario is built for
 
 
 class _Strict(BaseModel):
@@ -22,14 +24,14 @@ class StartRequest(_Strict):
     """Start a new ride.
 
     Attributes:
-        traffic_level: demand scale, in (0, 1.5] (1.0 = 900 veh/h on the main road).
+        traffic_level: demand scale, in (0, 1.75] (1.0 = 900 veh/h on the main road).
         seed: simulation seed; the same seed and level give the same traffic.
         command: the command the car starts with.
         max_steps: longest ride [s].
     """
 
     traffic_level: float = Field(default=1.0, gt=0, le=MAX_TRAFFIC_LEVEL)
-    seed: int = Field(default=0, ge=0, lt=2**31)
+    seed: int = Field(default=0, ge=0, lt=SEED_LIMIT)
     command: Literal["fast", "comfort", "stop"] = "comfort"
     max_steps: int = Field(default=600, gt=0, le=MAX_RIDE_STEPS)
 
