@@ -63,6 +63,24 @@ def cues(text: str) -> dict[str, float]:
         ("This will do, thanks.", {"arrival": 1.0}),
         ("Right here is fine.", {"arrival": 1.0}),  # one phrase, counted once
         ("How far is it from here?", {}),
+        # places and arrivals in narration are not requests to stop
+        ("We're finally here in Madrid, what a trip.", {}),
+        ("The meeting ends right here at five, then dinner.", {}),
+        ("We're here for a week, then off to Rome.", {}),
+        ("Right here, please.", {"arrival": 1.0}),
+        ("Just here is fine.", {"arrival": 1.0}),
+        ("We're here!", {"arrival": 1.0}),
+        # stop phrases with an object are something else
+        ("Drop me a text when the match is over.", {}),
+        ("Drop me at the corner.", {"stop_request": 1.0}),
+        ("Pull up the map.", {}),
+        ("Pull up here.", {"stop_request": 1.0}),
+        ("Get out of here, really?", {}),
+        ("Let me get out of the car.", {"stop_request": 1.0}),
+        # "stop" after a modal with another subject is a mention
+        ("The rain should stop by the afternoon.", {"stop_noun": 1.0}),
+        ("You can stop here.", {"stop_request": 1.0}),
+        ("We should stop.", {"stop_request": 1.0}),
         # chat spellings: "ez" is "easy", "to fast" is "too fast"
         ("ez on the pedal plz", {"slow": 1.0}),
         ("to quick man", {"neg_fast": 1.0}),

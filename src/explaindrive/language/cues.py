@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import difflib
 import re
+from collections.abc import Callable
 from functools import lru_cache
 
 import numpy as np
@@ -81,10 +82,21 @@ STOP_PHRASES: tuple[tuple[str, ...], ...] = (
     ("jump", "out"),
     ("park", "it"),
 )
+# Stop phrases with an object are something else: "drop me a line", "pull up the map",
+# "get off the phone", "get out of here!" (surprise).
+_OBJECTS = _words("a an the some any your his her their my this that")
+_NOT_STOP_AFTER: dict[tuple[str, ...], frozenset[str]] = {
+    ("drop", "me"): _OBJECTS,
+    ("pull", "up"): _OBJECTS,
+    ("get", "off"): _OBJECTS,
+    ("get", "out"): _OBJECTS | {"of"},
+}
+_VEHICLES = _words("car cab taxi vehicle")  # "get out of the car" is a stop
+# "the rain should stop", "the bus will stop there": a mention, unless the car is meant
+_MODALS = _words("will would should might may must could can")
+_REQUEST_SUBJECTS = _words("you u ya we")
 # Arrival: the passenger signals that the car is where they want to get out.
-ARRIVAL_PHRASES: tuple[tuple[str, ...], ...] = (
-    ("we're", "here"),
-    ("we", "are", "here"),
+_ARRIVALS: tuple[tuple[str, ...], ...] = (
     ("we've", "arrived"),
     ("we", "have", "arrived"),
     ("this", "will", "do"),
@@ -95,15 +107,30 @@ ARRIVAL_PHRASES: tuple[tuple[str, ...], ...] = (
     ("here", "is", "good"),
     ("here's", "good"),
     ("here", "works"),
+    ("that's", "us"),
+    ("this", "is", "us"),
+    ("walk", "from", "here"),
+    ("on", "foot", "from", "here"),
+)
+# Places and arrivals that are also ordinary narration ("we're here for a week", "the
+# meeting ends right here at five"): they count only as the end of a clause or before an
+# arrival word ("right here, please", "just here is fine").
+_PLACES: tuple[tuple[str, ...], ...] = (
+    ("we're", "here"),
+    ("we", "are", "here"),
     ("right", "here"),
     ("just", "here"),
     ("this", "is", "it"),
-    ("that's", "us"),
-    ("this", "is", "us"),
     ("on", "foot"),
-    ("walk", "from", "here"),
     ("drop", "off"),
 )
+ARRIVAL_PHRASES: tuple[tuple[str, ...], ...] = _ARRIVALS + _PLACES
+_PLACE_PHRASES = frozenset(_PLACES)
+_ARRIVAL_FOLLOWERS = _words(
+    """please pls plz thanks thank thx ta cheers fine good great perfect ok okay mate driver
+    do already now right here lol"""
+)
+_LINKS = _words("is 's will would works")  # "right here is fine", "just here will do"
 CONTINUE_WORDS = _words("further farther continue continuing anymore another beyond past")
 # Words and phrases that ask to go on driving (negated: "don't carry on" asks to stop).
 CONTINUE_VERBS = _words("continue continuing resume")
@@ -215,6 +242,7 @@ CUE_NAMES: tuple[str, ...] = (
     "continue",  # "keep going", "carry on", "you can go on", "no need to stop"
 )
 N_CUES = len(CUE_NAMES)
+_Add = Callable[[str], None]
 _INDEX = {name: i for i, name in enumerate(CUE_NAMES)}
 
 
@@ -308,10 +336,9 @@ def speed_number_cues(tokens: list[str], negated: list[bool]) -> list[str]:
     return out
 
 
-def cue_vector(text: str) -> NDArray[np.float32]:
-    """Counts of each cue in :data:`CUE_NAMES` for one request (each capped at 2)."""
-    raw = tokenize(text)
-    tokens = [canonical(t) for t in raw]
+def _cue_tokens(text: str) -> list[str]:
+    """Canonical tokens of ``text``, with "to" read as "too" before a pace adjective."""
+    tokens = [canonical(t) for t in tokenize(text)]
     n = len(tokens)
     for i in range(n - 1):
         after = tokens[i + 2] if i + 2 < n else "."
@@ -321,32 +348,86 @@ def cue_vector(text: str) -> NDArray[np.float32]:
             and (after in _CLAUSE_BREAKS or after in _ADDRESS)
         ):
             tokens[i] = "too"
-    negated = [False] * n
-    stop_role: dict[int, str] = {}
+    return tokens
+
+
+def _stop_role(tokens: list[str], i: int) -> str | None:
+    """The role of a stop word at ``i`` when it is not a plain request (else ``None``)."""
+    n = len(tokens)
+    t = tokens[i]
+    nxt = tokens[i + 1] if i + 1 < n else ""
+    prev = tokens[i - 1] if i > 0 else ""
+    if (
+        t in _QUIT_VERBS
+        and nxt in _MOTION_GERUNDS
+        and (i + 2 >= n or tokens[i + 2] in _CLAUSE_BREAKS or tokens[i + 2] in _HALT_FOLLOWERS)
+    ):
+        return "request"  # "stop moving now", "cease driving."
+    if t in _QUIT_VERBS and (_is_gerund(nxt) or nxt == "being"):
+        return "negator"  # "stop speeding" = do not speed
+    if t == "stop" and prev in _POSSESSIVES:
+        return "destination"
+    if t in ("stop", "stops") and (prev in _DETERMINERS or prev == "bus"):
+        return "noun"
+    subject = tokens[i - 2] if i >= 2 else ""
+    if (
+        t == "stop"
+        and prev in _MODALS
+        and subject
+        and subject not in _REQUEST_SUBJECTS
+        and subject not in _CLAUSE_BREAKS
+    ):
+        return "noun"  # "the rain should stop": a mention, not a request
+    return None
+
+
+def _negation_and_stop_roles(tokens: list[str]) -> tuple[list[bool], dict[int, str]]:
+    """Which tokens are negated, and the role of each stop word that is not a request."""
+    negated = [False] * len(tokens)
+    roles: dict[int, str] = {}
     for i, t in enumerate(tokens):
-        nxt = tokens[i + 1] if i + 1 < n else ""
         prev = tokens[i - 1] if i > 0 else ""
         if t in NEGATORS or (t == "need" and prev == "no"):
             _in_scope(tokens, negated, i)
-        elif (
-            t in _QUIT_VERBS
-            and nxt in _MOTION_GERUNDS
-            and (i + 2 >= n or tokens[i + 2] in _CLAUSE_BREAKS or tokens[i + 2] in _HALT_FOLLOWERS)
-        ):
-            stop_role[i] = "request"  # "stop moving now", "cease driving."
-        elif t in _QUIT_VERBS and (_is_gerund(nxt) or nxt == "being"):
-            stop_role[i] = "negator"  # "stop speeding" = do not speed
+            continue
+        role = _stop_role(tokens, i)
+        if role is not None:
+            roles[i] = role
+        if role == "negator":
             _in_scope(tokens, negated, i)
-        elif t == "stop" and prev in _POSSESSIVES:
-            stop_role[i] = "destination"
-        elif t in ("stop", "stops") and (prev in _DETERMINERS or prev == "bus"):
-            stop_role[i] = "noun"
-    v = np.zeros(N_CUES, dtype=np.float32)
+    return negated, roles
 
-    def add(name: str) -> None:
-        v[_INDEX[name]] += 1.0
 
-    consumed = [False] * n  # words already counted as part of a phrase
+def _phrase_applies(tokens: list[str], i: int, phrase: tuple[str, ...]) -> bool:
+    """Whether ``phrase`` at ``i`` has the use its cue stands for (see the phrase lists)."""
+    k = len(phrase)
+    after = tokens[i + k] if i + k < len(tokens) else "."
+    if phrase in _CLAUSE_FINAL_PHRASES:
+        return after in _CLAUSE_BREAKS
+    if phrase in _PLACE_PHRASES:
+        link = tokens[i + k + 1] if i + k + 1 < len(tokens) else ""
+        return (
+            after in _CLAUSE_BREAKS
+            or after in _ARRIVAL_FOLLOWERS
+            or (after in _LINKS and link in _ARRIVAL_FOLLOWERS)
+        )
+    return True
+
+
+def _stop_phrase_applies(tokens: list[str], i: int, phrase: tuple[str, ...]) -> bool:
+    """A stop phrase with an object is something else ("drop me a line", "get out of here")."""
+    k = len(phrase)
+    after = tokens[i + k] if i + k < len(tokens) else ""
+    if after not in _NOT_STOP_AFTER.get(phrase, frozenset()):
+        return True
+    # "get out of the car" is still a stop
+    return phrase == ("get", "out") and any(t in _VEHICLES for t in tokens[i + k : i + k + 4])
+
+
+def _phrase_cues(tokens: list[str], negated: list[bool], add: _Add) -> list[bool]:
+    """Count the multi-word cues; returns which tokens they consumed."""
+    n = len(tokens)
+    consumed = [False] * n
     for i in range(n):
         for phrases, plain, flipped in (
             (NEEDLESS_PACE_PHRASES, "neg_fast", "neg_fast"),
@@ -358,14 +439,19 @@ def cue_vector(text: str) -> NDArray[np.float32]:
             for phrase in phrases:
                 k = len(phrase)
                 if (
-                    phrase in _CLAUSE_FINAL_PHRASES
-                    and i + k < n
-                    and tokens[i + k] not in _CLAUSE_BREAKS
+                    not any(consumed[i : i + k])
+                    and tuple(tokens[i : i + k]) == phrase
+                    and _phrase_applies(tokens, i, phrase)
                 ):
-                    continue
-                if not any(consumed[i : i + k]) and tuple(tokens[i : i + k]) == phrase:
                     add(flipped if negated[i] else plain)
                     consumed[i : i + k] = [True] * k
+    return consumed
+
+
+def _word_cues(
+    tokens: list[str], negated: list[bool], roles: dict[int, str], consumed: list[bool], add: _Add
+) -> None:
+    """Count the single-word cues and the stop phrases."""
     for i, t in enumerate(tokens):
         if consumed[i]:
             pass
@@ -381,15 +467,31 @@ def cue_vector(text: str) -> NDArray[np.float32]:
             add("neg_continue")
         elif t in CONTINUE_VERBS:
             add("continue")
-        if t in STOP_VERBS and negated[i] and i not in stop_role:
+        if t in STOP_VERBS and negated[i] and i not in roles:
             add("continue")  # "don't stop", "no need to stop", "without stopping"
         elif t in STOP_VERBS or t == "stops":
-            role = stop_role.get(i, "noun" if t == "stops" else "request")
+            role = roles.get(i, "noun" if t == "stops" else "request")
             if role in ("request", "noun", "destination"):
                 add(f"stop_{role}" if role != "request" else "stop_request")
         for phrase in STOP_PHRASES:
-            if tuple(tokens[i : i + len(phrase)]) == phrase:
+            if tuple(tokens[i : i + len(phrase)]) == phrase and _stop_phrase_applies(
+                tokens, i, phrase
+            ):
                 add("stop_request")
+
+
+def cue_vector(text: str) -> NDArray[np.float32]:
+    """Counts of each cue in :data:`CUE_NAMES` for one request (each capped at 2)."""
+    tokens = _cue_tokens(text)
+    n = len(tokens)
+    negated, roles = _negation_and_stop_roles(tokens)
+    v = np.zeros(N_CUES, dtype=np.float32)
+
+    def add(name: str) -> None:
+        v[_INDEX[name]] += 1.0
+
+    consumed = _phrase_cues(tokens, negated, add)
+    _word_cues(tokens, negated, roles, consumed, add)
     for name in speed_number_cues(tokens, negated):
         add(name)
     # "not one more meter", "not another inch": a negated quantity of further driving

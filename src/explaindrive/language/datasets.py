@@ -74,10 +74,14 @@ DEV_SPLITS: tuple[str, ...] = (
     DEV14_CSV,
 )
 """The development splits, each written in its own round; LLM-1 selection holds each out."""
-TEST_CSV = "commands_test10.csv"
-"""Held-out requests of round 15, written from the labelling guide alone and committed
-before any model judged on it was evaluated; never used to build a shipped model."""
-TEST_SPLITS: tuple[str, ...] = (TEST_CSV,)
+TEST10_CSV = "commands_test10.csv"
+"""Held-out requests written from the labelling guide alone and committed before any
+model judged on it was evaluated; never used to build a shipped model."""
+TEST_CSV = "commands_test11.csv"
+"""Held-out requests written from the labelling guide (self-corrections and off-topic
+remarks that mention places, arrivals and stops included), committed before any model
+was judged on it; never used to build a shipped model. The default of ``eval intents``."""
+TEST_SPLITS: tuple[str, ...] = (TEST10_CSV, TEST_CSV)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 """The shipped LLM-1 weights over all-MiniLM-L6-v2."""

@@ -41,6 +41,10 @@ class IntentResult:
         latency_s: wall time of the call [s].
         scores: class probabilities when the backend exposes them (embedded), else empty.
         error: why the configured backend was bypassed, when ``fallback`` is ``True``.
+        instruction: when the request corrects itself ("faster... no, stop"), the part
+            after its last repair marker that decided the command; else ``None``.
+        stop_lane: ``True`` when the embedded STOP check answered before any remote
+            model was asked (a STOP is never left waiting on an endpoint).
     """
 
     intent: Command | None
@@ -50,6 +54,8 @@ class IntentResult:
     latency_s: float
     scores: dict[str, float]
     error: str | None = None
+    instruction: str | None = None
+    stop_lane: bool = False
 
     def to_json(self) -> dict[str, object]:
         """The CLI's JSON shape."""
@@ -58,6 +64,8 @@ class IntentResult:
             "confirmation": self.confirmation,
             "backend": self.backend,
             "fallback": self.fallback,
+            "instruction": self.instruction,
+            "stop_lane": self.stop_lane,
         }
 
 

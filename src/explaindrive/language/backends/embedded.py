@@ -7,6 +7,7 @@ import time
 
 from explaindrive.commands import Command
 from explaindrive.language.config import EmbeddedConfig
+from explaindrive.language.corrections import last_instruction
 from explaindrive.language.datasets import INTENT_LABELS
 from explaindrive.language.decision import Decision, ExplanationDecider, Factor, rule_decision
 from explaindrive.language.explanation import Explainer, Explanation, template_explanation
@@ -48,19 +49,38 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         self.encoder.load()
 
     def interpret(self, text: str) -> IntentResult:
-        """Classify ``text``; an empty or off-topic request gets a request to rephrase."""
+        """Classify ``text``; an empty or off-topic request gets a request to rephrase.
+
+        A request that corrects itself is read by its last instruction: the part after
+        its last repair marker (:func:`~explaindrive.language.corrections.last_instruction`)
+        decides whenever it asks for a command on its own.
+        """
         t0 = time.perf_counter()
         if not text or not text.strip():
             return IntentResult(None, REPHRASE_MESSAGE, NAME, False, time.perf_counter() - t0, {})
-        x = features(self.encoder, [text], self.classifier.spec)
-        p = self.classifier.proba(x)[0]
-        label = self.classifier.decide(p, self.config.stop_threshold, self.config.none_margin)
-        scores = {name: round(float(v), 4) for name, v in zip(INTENT_LABELS, p, strict=True)}
+        last = last_instruction(text)
+        texts = [text] if last is None else [text, last]
+        p = self.classifier.proba(features(self.encoder, texts, self.classifier.spec))
+        labels = [
+            self.classifier.decide(row, self.config.stop_threshold, self.config.none_margin)
+            for row in p
+        ]
+        row = 1 if last is not None and labels[1] != "none" else 0
+        label = labels[row]
+        scores = {name: round(float(v), 4) for name, v in zip(INTENT_LABELS, p[row], strict=True)}
         intent = None if label == "none" else Command.parse(label)
         confirmation = format_confirmation(intent) if intent is not None else REPHRASE_MESSAGE
         latency = time.perf_counter() - t0
         log.debug("embedded intent %s for %r (%s)", label, text, scores)
-        return IntentResult(intent, confirmation, NAME, False, latency, scores)
+        return IntentResult(
+            intent,
+            confirmation,
+            NAME,
+            False,
+            latency,
+            scores,
+            instruction=texts[row] if row == 1 else None,
+        )
 
 
 class RuleDecider(ExplanationDecider):
