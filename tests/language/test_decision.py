@@ -8,7 +8,9 @@ import pytest
 
 from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
 from explaindrive.language.decision import Conflict, Factor, parse_decision_tag, rule_decision
-from explaindrive.language.explanation import check_grounding, mentioned_factors
+from explaindrive.language.explanation import check_grounding, mentioned_factors, present_factors
+from explaindrive.language.grounding import reply_problems, wording_problems
+from explaindrive.language.hazards import braking_hazards
 from explaindrive.language.summary import StateRecord
 
 
@@ -89,3 +91,99 @@ def test_grounding_flags_absent_factor() -> None:
     r = rec("fast", -2, d_tl=30.0, tl_state="red")
     g = check_grounding("Slowing for the pedestrian ahead.", Factor.TRAFFIC_LIGHT, r)
     assert not g.ok and g.absent == (Factor.PEDESTRIAN,) and not g.names_factor
+
+
+def test_the_hazard_that_forces_the_action_is_named() -> None:
+    # a leader 6 m ahead closing at 5 m/s: slack (6 - 2 - 5^2/4) / 5 = -0.45 s; the
+    # crossing 42 m ahead at 10 m/s: (42 - 25) / 10 = 1.7 s
+    closing = rec("fast", -3, d_lead=6.0, dv=5.0, d_cross=42.0)
+    assert rule_decision(closing).factor is Factor.LEAD_VEHICLE
+    # a red light 15 m ahead (inside the 25 m stopping distance: -1.0 s) before a crossing
+    # 30 m ahead (0.5 s)
+    light_first = rec("fast", -2, d_tl=15.0, tl_state="red", d_cross=30.0)
+    assert rule_decision(light_first).factor is Factor.TRAFFIC_LIGHT
+    assert [h.factor for h in braking_hazards(light_first.nearby())] == [
+        Factor.TRAFFIC_LIGHT,
+        Factor.PEDESTRIAN,
+    ]
+    assert [round(h.slack_s, 2) for h in braking_hazards(light_first.nearby())] == [-1.0, 0.5]
+    # the same crossing nearer than the light leads
+    assert rule_decision(rec("fast", -2, d_tl=30.0, tl_state="red", d_cross=15.0)).factor is (
+        Factor.PEDESTRIAN
+    )
+
+
+def test_a_waiting_car_ranks_what_is_nearest() -> None:
+    # standing: slack is distance over 1 m/s
+    waiting = rec("fast", 0, v_ego=0.0, d_tl=25.0, tl_state="red", d_cross=3.0)
+    assert [h.slack_s for h in braking_hazards(waiting.nearby())] == [3.0, 25.0]
+    assert rule_decision(waiting).factor is Factor.PEDESTRIAN
+
+
+SWEEP_STATES: list[dict[str, Any]] = [
+    {"d_tl": 30.0, "tl_state": "red"},
+    {"d_tl": 40.0, "tl_state": "red", "d_cross": 25.0},
+    {"d_tl": 12.0, "tl_state": "yellow", "d_lead": 8.0, "dv": 2.0},
+    {"d_cross": 18.0, "d_lead": 6.0, "dv": 0.0},
+    {"v_lim": 8.3},
+]
+
+
+@pytest.mark.parametrize("state", SWEEP_STATES)
+@pytest.mark.parametrize("request_", ["fast", "comfort"])
+def test_template_wording_is_true_of_the_action_and_speed(
+    state: dict[str, Any], request_: str
+) -> None:
+    checked = 0
+    for speed in (0.0, 0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 10.0, 13.0):
+        for action in (-3, -2, -1, 0):
+            r = rec(request_, action, v_ego=speed, **state)
+            for factor in sorted(present_factors(r.nearby()) - {Factor.SPEED_LIMIT}) or [
+                Factor.SPEED_LIMIT
+            ]:
+                text = TemplateExplainer().explain(r, factor).text
+                assert wording_problems(text, r) == [], text
+                assert reply_problems(text, r, factor) == [], text
+                checked += 1
+    assert checked >= 36
+
+
+@pytest.mark.parametrize("speed", [8.0, 9.0, 10.0, 11.0, 12.0, 13.0])
+@pytest.mark.parametrize("distance", [30.0, 35.0, 40.0])
+def test_comfort_braking_before_a_red_light_is_not_called_a_stop(
+    speed: float, distance: float
+) -> None:
+    firm = TemplateExplainer().explain(
+        rec("comfort", -2, v_ego=speed, d_tl=distance, tl_state="red"), Factor.TRAFFIC_LIGHT
+    )
+    assert "stop" not in firm.text.lower() and "sorry" in firm.text.lower()
+    hard = TemplateExplainer().explain(
+        rec("comfort", -3, v_ego=speed, d_tl=distance, tl_state="red"), Factor.TRAFFIC_LIGHT
+    )
+    assert "easing off" not in hard.text
+    assert any(word in hard.text for word in ("hard", "sharply"))
+
+
+def test_stop_words_only_when_the_car_ends_the_step_at_rest() -> None:
+    stopping = rec("fast", -3, v_ego=2.5, d_tl=4.0, tl_state="red")  # 2.5 - 3 <= 0.5
+    text = TemplateExplainer().explain(stopping, Factor.TRAFFIC_LIGHT).text
+    assert "stop" in text or "halt" in text
+    moving = rec("fast", -3, v_ego=12.0, d_lead=5.0, dv=6.0)
+    assert wording_problems("Sorry about that quick stop.", moving) == [
+        "says a stop while the action is -3 m/s at 12.0 m/s"
+    ]
+    assert wording_problems("I'm easing off a little.", moving) == [
+        "says gentle braking while the action is -3 m/s at 12.0 m/s"
+    ]
+
+
+@pytest.mark.parametrize("action", [2, 3])
+def test_acceleration_through_a_yellow_light_is_explained_truly(action: int) -> None:
+    r = rec("comfort", action, v_ego=12.0, d_tl=15.0, tl_state="yellow")
+    text = TemplateExplainer().explain(r, Factor.TRAFFIC_LIGHT).text
+    assert "15 m" in text and "yellow" in text
+    assert reply_problems(text, r, Factor.TRAFFIC_LIGHT) == []
+    with pytest.raises(ValueError, match="cannot be explained"):
+        TemplateExplainer().explain(
+            rec("comfort", 2, d_tl=15.0, tl_state="red"), Factor.TRAFFIC_LIGHT
+        )

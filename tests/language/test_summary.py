@@ -41,10 +41,13 @@ def test_from_observation_rejects_bad_action_and_shape() -> None:
 
 def test_summary_cuts_off_at_50_m() -> None:
     rec = StateRecord.from_observation(_obs(0, 8, 13.9, 22, 1.5, 35, 2, 120), -2)
+    # the red light (slack (35 - 16) / 8 = 2.4 s) leads; the leader (headway 2.75 s,
+    # TTC 14.7 s) is no hazard and follows; the absent crossing comes last
     assert environment_summary(rec) == (
         "Ego speed 8.0 m/s (29 km/h); speed limit 13.9 m/s (50 km/h); urban area. "
-        "Vehicle ahead at 22 m, closing at 1.5 m/s. Red traffic light in 35 m. "
-        "No pedestrian crossing within 50 m."
+        "Red traffic light in 35 m. Vehicle ahead at 22 m, closing at 1.5 m/s. "
+        "No pedestrian crossing within 50 m. "
+        "Most urgent: the red traffic light 35 m ahead (a comfortable stop needs 16 m)."
     )
     far = StateRecord.from_observation(_obs(1, 5, 8.3, 60, 0, 55, 1, 51), 0)
     text = environment_summary(far)
@@ -74,3 +77,23 @@ def test_describe_action() -> None:
     assert describe_action(0) == "keeping its speed"
     with pytest.raises(ValueError):
         describe_action(4)
+
+
+def test_summary_lists_the_hazard_that_forces_the_action_first() -> None:
+    # red light 15 m at 10 m/s (inside the 25 m stopping distance) before a crossing 30 m
+    rec = StateRecord.model_validate(
+        {
+            "request": "fast",
+            "action": -2,
+            "state": {"v_ego": 10, "v_lim": 13.9, "d_tl": 15, "tl_state": "red", "d_cross": 30},
+        }
+    )
+    text = environment_summary(rec)
+    assert text.index("Red traffic light in 15 m") < text.index("Pedestrian crossing")
+    assert text.endswith(
+        "Most urgent: the red traffic light 15 m ahead (a comfortable stop needs 25 m)."
+    )
+    standing = StateRecord.model_validate(
+        {"request": "fast", "action": 0, "state": {"v_ego": 0, "v_lim": 13.9}}
+    )
+    assert "Most urgent" not in environment_summary(standing)

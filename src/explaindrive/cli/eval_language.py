@@ -82,7 +82,8 @@ def decisions_command(
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
 ) -> None:
-    """Trigger accuracy/precision/recall/F1, factor accuracy and grounding of LLM-2/LLM-3."""
+    """Trigger accuracy/precision/recall/F1, factor accuracy and checked explanations of
+    LLM-2/LLM-3."""
     try:
         rows = load_decisions(data)
         from explaindrive.language.stack import make_language_stack
@@ -97,8 +98,10 @@ def decisions_command(
     console.print(
         f"decisions ({stack.backend}, n={report['n']}): accuracy {report['accuracy']:.3f}  "
         f"precision {report['precision']:.3f}  recall {report['recall']:.3f}  "
-        f"F1 {report['f1']:.3f}  factor accuracy {report['factor_accuracy']}  "
-        f"grounded {report['grounded_share']}  fallbacks {report['fallbacks']}"
+        f"F1 {report['f1']:.3f}  factor accuracy {report['factor_accuracy']} "
+        f"(with several objects: {report['factor_accuracy_multi']}, n={report['n_multi']})  "
+        f"grounded {report['grounded_share']}  true to the state {report['truthful_share']}  "
+        f"fallbacks {report['fallbacks']}"
     )
     _write(out, report)
 

@@ -6,42 +6,58 @@ The rules follow the paper's three principles for the decision prompt:
    clear safety reason (decelerating under *fast*; harsh braking or acceleration under
    *comfort*);
 2. never for ordinary, supportive or neutral behaviour;
-3. with several reasons, keep the most safety-critical one.
+3. with several reasons, keep the most safety-critical one: the hazard the car has to
+   act on first (:mod:`explaindrive.language.hazards` ranks them by urgency).
 
 Only objects within the cut-off (50 m) count.
 """
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from enum import StrEnum
 
 from explaindrive.commands import Command
 from explaindrive.language.config import SUMMARY_CUTOFF_M
+from explaindrive.language.hazards import (
+    AT_LIMIT_MARGIN_MPS,
+    COMFORT_DECEL_MPS2,
+    HOLD_MARGIN_MPS,
+    MIN_GAP_M,
+    SHORT_HEADWAY_S,
+    SHORT_TTC_S,
+    Factor,
+    braking_hazards,
+    leader_is_hazard,
+    stopping_distance_m,
+)
 from explaindrive.language.summary import RecordState, StateRecord
+
+__all__ = [
+    "AT_LIMIT_MARGIN_MPS",
+    "COMFORT_DECEL_MPS2",
+    "EXPLAIN_TAG",
+    "HOLD_MARGIN_MPS",
+    "MIN_GAP_M",
+    "NO_EXPLANATION_TAG",
+    "SHORT_HEADWAY_S",
+    "SHORT_TTC_S",
+    "Conflict",
+    "Decision",
+    "ExplanationDecider",
+    "Factor",
+    "acceleration_factors",
+    "braking_factors",
+    "detect_conflict",
+    "leader_is_hazard",
+    "most_critical_factor",
+    "parse_decision_tag",
+    "rule_decision",
+]
 
 EXPLAIN_TAG = "[EXPLAIN]"
 NO_EXPLANATION_TAG = "[NO EXPLANATION NEEDED]"
-
-HOLD_MARGIN_MPS = 1.0  # [m/s] holding speed this far below the limit delays a "fast" request
-AT_LIMIT_MARGIN_MPS = 0.5  # [m/s] within this of the limit the limit explains braking
-SHORT_HEADWAY_S = 2.0  # [s] time headway below which the leader is a safety reason
-SHORT_TTC_S = 5.0  # [s] time to collision below which the leader is a safety reason
-MIN_GAP_M = 10.0  # [m] a leader closer than this is always a safety reason
-IMMINENT_TTC_S = 3.0  # [s] a leader this close in time outranks a traffic light
-IMMINENT_GAP_M = 5.0  # [m] ... and so does one this close in space
-COMFORT_DECEL_MPS2 = 2.0  # [m/s^2] comfortable braking, for the yellow-light dilemma zone
-
-
-class Factor(StrEnum):
-    """A safety-relevant factor an explanation can name."""
-
-    TRAFFIC_LIGHT = "traffic_light"
-    PEDESTRIAN = "pedestrian"
-    LEAD_VEHICLE = "lead_vehicle"
-    SPEED_LIMIT = "speed_limit"
 
 
 class Conflict(StrEnum):
@@ -122,52 +138,16 @@ def detect_conflict(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> 
     return Conflict.NONE
 
 
-def leader_is_hazard(s: RecordState) -> bool:
-    """Whether the leader is close enough (gap, headway or TTC) to be a safety reason."""
-    if s.d_lead is None:
-        return False
-    return s.d_lead < MIN_GAP_M or _headway_s(s) < SHORT_HEADWAY_S or _ttc_s(s) < SHORT_TTC_S
-
-
-def _headway_s(s: RecordState) -> float:
-    assert s.d_lead is not None
-    return s.d_lead / s.v_ego if s.v_ego > 0.1 else math.inf
-
-
-def _ttc_s(s: RecordState) -> float:
-    assert s.d_lead is not None
-    dv = s.dv or 0.0
-    return s.d_lead / dv if dv > 0.1 else math.inf
-
-
 def braking_factors(s: RecordState) -> list[Factor]:
-    """Safety reasons for slowing down, most critical first.
-
-    Order: an occupied pedestrian crossing; an imminent leader (TTC < 3 s or gap < 5 m);
-    a red or yellow light; a leader at short headway / TTC; being at the speed limit.
-    """
-    found: list[Factor] = []
-    if s.d_cross is not None:
-        found.append(Factor.PEDESTRIAN)
-    hazard = leader_is_hazard(s)
-    imminent = hazard and (_ttc_s(s) < IMMINENT_TTC_S or (s.d_lead or 0.0) < IMMINENT_GAP_M)
-    if imminent:
-        found.append(Factor.LEAD_VEHICLE)
-    if s.tl_state in ("red", "yellow"):
-        found.append(Factor.TRAFFIC_LIGHT)
-    if hazard and not imminent:
-        found.append(Factor.LEAD_VEHICLE)
-    if s.v_ego >= s.v_lim - AT_LIMIT_MARGIN_MPS:
-        found.append(Factor.SPEED_LIMIT)
-    return found
+    """Safety reasons for slowing down, most urgent first (see
+    :func:`~explaindrive.language.hazards.braking_hazards`)."""
+    return [h.factor for h in braking_hazards(s)]
 
 
 def acceleration_factors(s: RecordState) -> list[Factor]:
     """Safety reasons for accelerating firmly: a yellow light too close to stop comfortably."""
-    if s.tl_state == "yellow" and s.d_tl is not None:
-        stopping_m = s.v_ego**2 / (2 * COMFORT_DECEL_MPS2)
-        if s.d_tl < stopping_m:
-            return [Factor.TRAFFIC_LIGHT]
+    if s.tl_state == "yellow" and s.d_tl is not None and s.d_tl < stopping_distance_m(s.v_ego):
+        return [Factor.TRAFFIC_LIGHT]
     return []
 
 

@@ -16,8 +16,11 @@ from sklearn.metrics import (
 from explaindrive.commands import COMMAND_LABELS
 from explaindrive.language.datasets import CommandExample, LabelledRecord
 from explaindrive.language.decision import ExplanationDecider
-from explaindrive.language.explanation import Explainer, check_grounding
+from explaindrive.language.explanation import Explainer, check_grounding, present_factors
+from explaindrive.language.grounding import reply_problems
+from explaindrive.language.hazards import Factor
 from explaindrive.language.intent import IntentInterpreter, is_template_compliant
+from explaindrive.language.summary import StateRecord
 
 CONFUSION_LABELS: tuple[str, ...] = (*COMMAND_LABELS, "none")
 
@@ -105,15 +108,18 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
 def evaluate_decisions(
     decider: ExplanationDecider, explainer: Explainer, rows: list[LabelledRecord]
 ) -> dict[str, Any]:
-    """Trigger accuracy/precision/recall/F1, factor accuracy, and grounded explanations.
+    """Trigger accuracy/precision/recall/F1, factor accuracy, and checked explanations.
 
     Factor accuracy is over the labelled ``explain`` rows that the decider also chose to
-    explain. Every explanation is checked: it names the labelled factor and no factor
-    absent from the state.
+    explain; ``factor_accuracy_multi`` over those whose state holds two or more objects
+    (light, crossing, leader) within the cut-off. Every explanation is checked: it names
+    the labelled factor and no factor absent from the state (``grounded_share``), and it
+    passes :func:`~explaindrive.language.grounding.reply_problems` — the light's colour,
+    distances and speeds, and wording true of the action and speed (``truthful_share``).
     """
     truth: list[bool] = []
     pred: list[bool] = []
-    factor_hits: list[bool] = []
+    factor_hits: list[tuple[bool, bool]] = []  # (hit, multi-factor)
     texts: list[dict[str, Any]] = []
     lat_decide: list[float] = []
     lat_explain: list[float] = []
@@ -128,24 +134,14 @@ def evaluate_decisions(
         if d.explain:
             e = explainer.explain(rec, d.factor)
             lat_explain.append(e.latency_s)
-            g = check_grounding(e.text, row.factor, rec)
-            texts.append(
-                {
-                    "id": row.id,
-                    "factor": d.factor.value if d.factor else None,
-                    "label_factor": row.factor.value if row.factor else None,
-                    "text": e.text,
-                    "names_factor": g.names_factor,
-                    "absent_factors": [f.value for f in g.absent],
-                    "grounded": g.ok,
-                }
-            )
+            texts.append(_checked_text(row, rec, d.factor, e.text))
             if row.explain:
-                factor_hits.append(d.factor == row.factor)
+                factor_hits.append((d.factor == row.factor, _objects(rec) >= 2))
     prec, rec_, f1, _ = precision_recall_fscore_support(
         truth, pred, average="binary", pos_label=True, zero_division=0
     )
     labelled = [t for t in texts if t["label_factor"] is not None]
+    multi = [hit for hit, is_multi in factor_hits if is_multi]
     return {
         "n": len(rows),
         "n_explain": int(sum(truth)),
@@ -153,11 +149,38 @@ def evaluate_decisions(
         "precision": round(float(prec), 4),
         "recall": round(float(rec_), 4),
         "f1": round(float(f1), 4),
-        "factor_accuracy": round(float(np.mean(factor_hits)), 4) if factor_hits else None,
-        "grounded_share": round(float(np.mean([t["grounded"] for t in labelled])), 4)
-        if labelled
-        else None,
+        "factor_accuracy": _share([hit for hit, _ in factor_hits]),
+        "factor_accuracy_multi": _share(multi),
+        "n_multi": len(multi),
+        "grounded_share": _share([t["grounded"] for t in labelled]),
+        "truthful_share": _share([not t["problems"] for t in texts]),
         "fallbacks": fallbacks,
         "latency": {"decide": _percentiles(lat_decide), "explain": _percentiles(lat_explain)},
         "explanations": texts,
+    }
+
+
+def _share(flags: list[bool]) -> float | None:
+    return round(float(np.mean(flags)), 4) if flags else None
+
+
+def _objects(rec: StateRecord) -> int:
+    """Objects (light, crossing, leader) in the state within the cut-off."""
+    return len(present_factors(rec.nearby()) - {Factor.SPEED_LIMIT})
+
+
+def _checked_text(
+    row: LabelledRecord, rec: StateRecord, factor: Factor | None, text: str
+) -> dict[str, Any]:
+    """One explanation with the results of the grounding and truth checks."""
+    g = check_grounding(text, row.factor, rec)
+    return {
+        "id": row.id,
+        "factor": factor.value if factor else None,
+        "label_factor": row.factor.value if row.factor else None,
+        "text": text,
+        "names_factor": g.names_factor,
+        "absent_factors": [f.value for f in g.absent],
+        "grounded": g.ok,
+        "problems": reply_problems(text, rec, factor),
     }

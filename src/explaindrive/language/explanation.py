@@ -98,12 +98,20 @@ def check_grounding(
 
 # --- the embedded generator ----------------------------------------------------------------
 
+# What the car is doing, in words true of the action and the speed: "stop" only when
+# this step ends at a standstill, "easing off" only for gentle braking (-1 m/s).
 _OPENERS: dict[str, tuple[str, ...]] = {
-    "brake": ("I'm slowing down", "I'm easing off a little", "I'm reducing our speed"),
-    "harsh_brake": (
-        "Sorry for the firm braking",
-        "Apologies for braking a bit sharply",
-        "Sorry about that quick stop",
+    "stopping": (
+        "I'm bringing us to a stop",
+        "I'm stopping the car",
+        "I'm bringing the car to a halt",
+    ),
+    "hard_brake": ("I'm braking hard", "I had to brake hard", "I'm braking sharply"),
+    "firm_brake": ("I'm braking", "I'm slowing us down firmly", "I had to brake firmly"),
+    "gentle_brake": (
+        "I'm easing off a little",
+        "I'm slowing down gently",
+        "I'm reducing our speed a little",
     ),
     "hold": (
         "I'm holding our speed for now",
@@ -121,7 +129,7 @@ _OPENERS: dict[str, tuple[str, ...]] = {
         "Sorry for speeding up so briskly",
     ),
 }
-
+STANDSTILL_MPS = 0.5  # [m/s] at or below this speed the car counts as stopped
 _REASONS: dict[Factor, tuple[str, ...]] = {
     Factor.PEDESTRIAN: (
         "because a pedestrian is crossing the street {d_cross} m ahead",
@@ -146,8 +154,8 @@ _REASONS: dict[Factor, tuple[str, ...]] = {
 }
 
 _ACCEL_REASON = (
-    "the traffic light {d_tl} m ahead just turned yellow and it is safer to clear the "
-    "intersection than to brake hard"
+    "the traffic light {d_tl} m ahead just turned yellow, too close to pull up "
+    "comfortably, so it is safer to clear the intersection"
 )
 
 _CLOSERS: dict[Factor, tuple[str, ...]] = {
@@ -179,14 +187,19 @@ def _pick(options: tuple[str, ...], key: str) -> str:
     return options[int.from_bytes(digest, "big") % len(options)]
 
 
-def _opener_kind(record: StateRecord, state: RecordState) -> str:
-    if record.action >= 2 and record.request == "comfort":
+def opener_kind(record: StateRecord) -> str:
+    """How the record's action reads in words: ``stopping`` (this step ends at a
+    standstill), ``hard_brake`` (-3), ``firm_brake`` (-2), ``gentle_brake`` (-1), ``wait``
+    (standing), ``hold`` or ``accelerate``."""
+    v = record.state.v_ego
+    a = record.action
+    if a > 0:
         return "accelerate"
-    if record.request == "comfort" and record.action <= -2:
-        return "harsh_brake"
-    if record.action < 0:
-        return "brake"
-    return "wait" if state.v_ego < 0.1 else "hold"
+    if a < 0 and v > STANDSTILL_MPS and v + a <= STANDSTILL_MPS:
+        return "stopping"
+    if a < 0:
+        return {-3: "hard_brake", -2: "firm_brake"}.get(a, "gentle_brake")
+    return "wait" if v <= STANDSTILL_MPS else "hold"
 
 
 def template_explanation(
@@ -195,10 +208,12 @@ def template_explanation(
     """One or two friendly sentences naming ``factor`` with its distance (deterministic).
 
     The wording varies with the record (a hash picks among several phrasings) but
-    only the chosen factor and values from the state are ever mentioned.
+    only the chosen factor and values from the state are ever mentioned, and what the
+    car is said to do matches the action and the speed (:func:`opener_kind`).
 
     Raises:
-        ValueError: if ``factor`` is not present in the record's state within ``cutoff_m``.
+        ValueError: if ``factor`` is not present in the record's state within ``cutoff_m``,
+            or for an acceleration that only a yellow light too close to stop at explains.
     """
     s = record.nearby(cutoff_m)
     if factor not in present_factors(s):
@@ -211,14 +226,16 @@ def template_explanation(
         "v_lim_kmh": f"{round(s.v_lim * 3.6)}",
     }
     key = record.model_dump_json()
-    kind = _opener_kind(record, s)
+    kind = opener_kind(record)
     opener = _pick(_OPENERS[kind], key + "o")
-    if kind == "accelerate" and factor is Factor.TRAFFIC_LIGHT:
+    if kind == "accelerate":  # only a yellow light too close to stop at explains it
+        if record.action < 2 or factor is not Factor.TRAFFIC_LIGHT or s.tl_state != "yellow":
+            raise ValueError(
+                f"accelerating by {record.action} m/s cannot be explained by {factor.value}"
+            )
         return f"{opener}: {_ACCEL_REASON.format(**values)}. Everything is under control."
-    if kind == "accelerate":  # harsh acceleration is only ever explained by a yellow light
-        raise ValueError(f"harsh acceleration cannot be explained by {factor.value}")
     reason = _pick(_REASONS[factor], key + "r").format(**values)
     closer = _pick(_CLOSERS[factor], key + "c")
-    if kind == "harsh_brake":
-        return f"{opener}, I had to slow down {reason}. {closer}"
+    if record.request == "comfort" and record.action <= -2:
+        opener = f"Sorry, {opener}"  # harsh braking under comfort: "Sorry, I'm braking hard"
     return f"{opener} {reason}. {closer}"

@@ -13,6 +13,7 @@ objects farther than a cut-off (50 m in the paper), see :meth:`StateRecord.nearb
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Literal, TypeVar
 
@@ -23,6 +24,14 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from explaindrive.commands import Command
 from explaindrive.env.state import SENSOR_RANGE_M, DrivingState, LightState
 from explaindrive.language.config import SUMMARY_CUTOFF_M
+from explaindrive.language.hazards import (
+    Factor,
+    Hazard,
+    braking_hazards,
+    headway_s,
+    stopping_distance_m,
+    ttc_s,
+)
 from explaindrive.validation import describe_errors
 
 _M = TypeVar("_M", bound=BaseModel)
@@ -193,38 +202,83 @@ def _kmh(v_mps: float) -> int:
 
 
 def environment_summary(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> str:
-    """The paper's human-readable environment summary (section 4.2).
+    """The paper's human-readable environment summary (section 4.2), most urgent first.
 
-    Objects farther than ``cutoff_m`` are left out.
+    Objects farther than ``cutoff_m`` are left out. The objects present are listed by
+    urgency (:func:`~explaindrive.language.hazards.braking_hazards`: the one the car has
+    to brake for first leads), and a last sentence names the most urgent reason to slow
+    down, with the figure that makes it urgent.
 
     Example:
         ``Ego speed 8.0 m/s (29 km/h); speed limit 13.9 m/s (50 km/h); urban area.
-        Vehicle ahead at 22 m, closing at 1.5 m/s. Red traffic light in 35 m.
-        No pedestrian crossing within 50 m.``
+        Red traffic light in 35 m. Vehicle ahead at 22 m, closing at 1.5 m/s.
+        No pedestrian crossing within 50 m. Most urgent: the red traffic light 35 m
+        ahead (a comfortable stop needs 16 m).``
     """
     s = record.nearby(cutoff_m)
-    limit = f"{cutoff_m:g} m"
     parts = [
         f"Ego speed {s.v_ego:.1f} m/s ({_kmh(s.v_ego)} km/h); speed limit {s.v_lim:.1f} m/s "
         f"({_kmh(s.v_lim)} km/h); {area_type(s.v_lim)} area."
     ]
-    if s.d_lead is None:
-        parts.append(f"No vehicle ahead within {limit}.")
-    else:
-        dv = s.dv or 0.0
-        if dv > 0.05:
-            rel = f", closing at {dv:.1f} m/s"
-        elif dv < -0.05:
-            rel = f", pulling away at {-dv:.1f} m/s"
-        else:
-            rel = ", same speed"
-        parts.append(f"Vehicle ahead at {s.d_lead:.0f} m{rel}.")
-    if s.d_tl is None or s.tl_state is None:
-        parts.append(f"No traffic light within {limit}.")
-    else:
-        parts.append(f"{s.tl_state.capitalize()} traffic light in {s.d_tl:.0f} m.")
-    if s.d_cross is None:
-        parts.append(f"No pedestrian crossing within {limit}.")
-    else:
-        parts.append(f"Pedestrian crossing the street {s.d_cross:.0f} m ahead.")
+    hazards = braking_hazards(s)
+    urgent = [h.factor.value for h in hazards]
+    present = {
+        "lead_vehicle": _lead_sentence(s),
+        "traffic_light": _light_sentence(s),
+        "pedestrian": _crossing_sentence(s),
+    }
+    order = sorted(present, key=lambda f: urgent.index(f) if f in urgent else len(urgent))
+    parts += [present[f] for f in order if present[f] is not None]  # type: ignore[misc]
+    limit = f"{cutoff_m:g} m"
+    absent = {
+        "lead_vehicle": f"No vehicle ahead within {limit}.",
+        "traffic_light": f"No traffic light within {limit}.",
+        "pedestrian": f"No pedestrian crossing within {limit}.",
+    }
+    parts += [absent[f] for f in order if present[f] is None]
+    if hazards:
+        parts.append(f"Most urgent: {_urgency_phrase(s, hazards[0])}.")
     return " ".join(parts)
+
+
+def _lead_sentence(s: RecordState) -> str | None:
+    if s.d_lead is None:
+        return None
+    dv = s.dv or 0.0
+    if dv > 0.05:
+        rel = f", closing at {dv:.1f} m/s"
+    elif dv < -0.05:
+        rel = f", pulling away at {-dv:.1f} m/s"
+    else:
+        rel = ", same speed"
+    return f"Vehicle ahead at {s.d_lead:.0f} m{rel}."
+
+
+def _light_sentence(s: RecordState) -> str | None:
+    if s.d_tl is None or s.tl_state is None:
+        return None
+    return f"{s.tl_state.capitalize()} traffic light in {s.d_tl:.0f} m."
+
+
+def _crossing_sentence(s: RecordState) -> str | None:
+    if s.d_cross is None:
+        return None
+    return f"Pedestrian crossing the street {s.d_cross:.0f} m ahead."
+
+
+def _urgency_phrase(s: RecordState, hazard: Hazard) -> str:
+    """What makes ``hazard`` urgent, in words ("the red traffic light 15 m ahead (...)")."""
+    need = f"a comfortable stop needs {stopping_distance_m(s.v_ego):.0f} m"
+    if hazard.factor is Factor.TRAFFIC_LIGHT:
+        return f"the {s.tl_state} traffic light {s.d_tl:.0f} m ahead ({need})"
+    if hazard.factor is Factor.PEDESTRIAN:
+        return f"the pedestrian crossing {s.d_cross:.0f} m ahead ({need})"
+    if hazard.factor is Factor.LEAD_VEHICLE:
+        ttc = ttc_s(s)
+        timing = (
+            f"time to collision {ttc:.1f} s"
+            if math.isfinite(ttc)
+            else f"time headway {headway_s(s):.1f} s"
+        )
+        return f"the vehicle {s.d_lead:.0f} m ahead ({timing})"
+    return f"the {_kmh(s.v_lim)} km/h speed limit (ego speed {_kmh(s.v_ego)} km/h)"
