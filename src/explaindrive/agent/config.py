@@ -296,7 +296,7 @@ PAPER = TrainConfig()
 """The paper's values: 2x128, Adam 1e-3, MSE, 5M replay, batch 64, gamma 0.99, 11,000 episodes."""
 
 SAFE = TrainConfig(
-    episodes=2500,
+    episodes=1600,
     lr=1e-3,
     lr_final=1e-4,
     lr_decay_steps=400_000,
