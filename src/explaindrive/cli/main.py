@@ -15,6 +15,7 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # help text as written: "[s]" is a unit, not Rich markup
 )
 
 # Each module exposes ``register(app)``; one line per command module.
