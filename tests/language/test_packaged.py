@@ -55,3 +55,26 @@ def test_the_installed_models_are_the_pinned_ones() -> None:
     assert WHISPER_TINY_EN.sha256.startswith("1a5afae0") and WHISPER_TINY_EN.sha256.endswith("6b2a")
     for model in (MINILM, WHISPER_TINY_EN):
         assert (packaged_model_dir(model) / model.weights).is_file()
+
+
+def test_transcribe_refuses_tampered_weights_in_one_line(
+    tmp_path: Path, fake_package: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import wave
+
+    from typer.testing import CliRunner
+
+    from explaindrive.cli.main import app
+
+    (fake_package / "model.bin").write_bytes(b"tampered")
+    monkeypatch.setattr("explaindrive.language.speech.WHISPER_TINY_EN", TOY)
+    clip = tmp_path / "clip.wav"
+    with wave.open(str(clip), "wb") as w:
+        w.setnchannels(1)
+        w.setsampwidth(2)
+        w.setframerate(16_000)
+        w.writeframes((b"\x00\x10\x00\xf0") * 8000)  # 1 s of a square wave
+    result = CliRunner().invoke(app, ["transcribe", str(clip)])
+    assert result.exit_code != 0 and "Traceback" not in result.output
+    text = " ".join(result.output.split())
+    assert "from package 'fake-model-pkg' is not the pinned release" in text
