@@ -2,6 +2,7 @@
 
     python scripts/ship_policy.py --run runs/fast --name fast --evaluation out/eval/fast.json
 
+The run's training log (``episodes.csv``) ships next to it as ``<name>_episodes.csv``.
 The evaluation file is the ``--json`` output of ``explaindrive evaluate`` on the
 paper's grid (5 seeds x 5 traffic levels); its overall aggregate and the command
 that produced it go into the card's ``evaluation`` field.
@@ -36,7 +37,7 @@ def main() -> None:
     )
     args = parser.parse_args()
     policy, card_file = args.run / "policy.pt", args.run / "policy.json"
-    for path in (policy, card_file):
+    for path in (policy, card_file, args.run / "episodes.csv"):
         if not path.is_file():
             raise SystemExit(f"missing {path}: finish the training run first")
     card = json.loads(card_file.read_text())
@@ -59,6 +60,7 @@ def main() -> None:
     card["evaluation"] = evaluations or None
     POLICY_DIR.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(policy, POLICY_DIR / f"{args.name}.pt")
+    shutil.copyfile(args.run / "episodes.csv", POLICY_DIR / f"{args.name}_episodes.csv")
     (POLICY_DIR / f"{args.name}.json").write_text(json.dumps(card, indent=2, sort_keys=True) + "\n")
     print(f"shipped {args.name}: {POLICY_DIR / (args.name + '.pt')}")
 
