@@ -125,3 +125,89 @@ def openai_server() -> Iterator[ScriptedOpenAI]:
     srv = ScriptedOpenAI()
     yield srv
     srv.close()
+
+
+class MisbehavingEndpoint:
+    """An OpenAI-compatible address on 127.0.0.1 that never answers in time.
+
+    ``mode="hang"`` reads the request and sends nothing; ``mode="drip"`` sends a valid
+    HTTP response (status line, headers and a chat completion) one byte every
+    ``interval_s`` seconds. ``bodies`` records every request body.
+    """
+
+    def __init__(self, mode: str, interval_s: float = 1.0) -> None:
+        if mode not in ("hang", "drip"):
+            raise ValueError(f"unknown mode {mode!r}")
+        self.mode = mode
+        self.bodies: list[dict[str, Any]] = []
+        self._closed = threading.Event()
+        outer = self
+
+        class Handler(BaseHTTPRequestHandler):
+            def log_message(self, *args: Any) -> None:
+                pass
+
+            def do_POST(self) -> None:
+                length = int(self.headers.get("Content-Length", "0"))
+                outer.bodies.append(json.loads(self.rfile.read(length) or b"{}"))
+                if outer.mode == "hang":
+                    outer._closed.wait(60.0)
+                    return
+                body = json.dumps(
+                    {
+                        "id": "chatcmpl-drip",
+                        "object": "chat.completion",
+                        "created": 0,
+                        "model": "drip",
+                        "choices": [
+                            {
+                                "index": 0,
+                                "finish_reason": "stop",
+                                "message": {
+                                    "role": "assistant",
+                                    "content": "You want me to drive faster, is this correct?",
+                                },
+                            }
+                        ],
+                    }
+                ).encode()
+                head = (
+                    "HTTP/1.1 200 OK\r\nContent-Type: application/json\r\n"
+                    f"Content-Length: {len(body)}\r\n\r\n"
+                ).encode()
+                for i in range(len(head + body)):
+                    if outer._closed.wait(interval_s):
+                        return
+                    with contextlib.suppress(OSError):  # the client gave up
+                        self.wfile.write((head + body)[i : i + 1])
+                        self.wfile.flush()
+                        continue
+                    return
+
+        self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.server.daemon_threads = True
+        self.base_url = f"http://127.0.0.1:{self.server.server_address[1]}/v1"
+        self.thread = threading.Thread(target=self.server.serve_forever, daemon=True)
+        self.thread.start()
+
+    @property
+    def requests(self) -> int:
+        """Requests received so far."""
+        return len(self.bodies)
+
+    def said(self) -> list[str]:
+        """The user message of every request."""
+        return [b["messages"][-1]["content"] for b in self.bodies]
+
+    def close(self) -> None:
+        self._closed.set()
+        self.server.shutdown()
+        self.server.server_close()
+
+
+@pytest.fixture(params=["hang", "drip"])
+def bad_endpoint(request: pytest.FixtureRequest) -> Iterator[MisbehavingEndpoint]:
+    """An endpoint that hangs, then one that drips a byte a second (each test runs twice)."""
+    srv = MisbehavingEndpoint(request.param)
+    yield srv
+    srv.close()

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+import pytest
+
 from explaindrive.commands import Command
 from explaindrive.language.backends.embedded import (
     EmbeddedIntentInterpreter,
@@ -65,11 +67,11 @@ def test_http_500_and_timeout_fall_back(
     openai_server: ScriptedOpenAI, interpreter: EmbeddedIntentInterpreter
 ) -> None:
     openai_server.script = [("http", 500)]
-    r = OpenAIIntentInterpreter(client(openai_server), interpreter).interpret("Pull over now")
-    assert r.fallback and r.intent is Command.STOP and "500" in (r.error or "")
+    r = OpenAIIntentInterpreter(client(openai_server), interpreter).interpret("I feel sick")
+    assert r.fallback and r.intent is Command.COMFORT and "500" in (r.error or "")
     openai_server.script = [("slow", 1.0, "[EXPLAIN]")]
     d = OpenAIDecider(client(openai_server, timeout_s=0.3), RuleDecider()).decide(RED)
-    assert d.fallback and d.backend == "embedded" and "Timeout" in (d.error or "")
+    assert d.fallback and d.backend == "embedded" and "deadline" in (d.error or "")
     assert d.explain and d.factor is Factor.TRAFFIC_LIGHT
     assert d.latency_s < 0.9
 
@@ -101,6 +103,50 @@ def test_explanation_grounding(openai_server) -> None:  # type: ignore[no-untype
     assert openai_server.requests[0]["temperature"] == 0.2
     e = ex.explain(RED, Factor.TRAFFIC_LIGHT)
     assert e.fallback and "pedestrian" in (e.error or "") and "30 m" in e.text
+
+
+@pytest.mark.parametrize(
+    ("reply", "why"),
+    [
+        ("I'm sorry, but I can't help with that.", "a refusal, not an explanation"),
+        ("A cyclist just swerved in front of us.", "hazards the state does not hold: cyclist"),
+        ("We're entering a school zone, so I'm slowing down for the light.", "school zone"),
+        ("The light ahead is green, so I'm slowing down.", "says the light is green; it is red"),
+        ("The light 80 m ahead is yellow, so I'm braking.", "distance of 80 m; the state has 30 m"),
+        ("The light 80 m ahead is yellow, so I'm braking.", "says the light is yellow; it is red"),
+        ("Sorry about that quick stop, the light 30 m ahead is red.", "says a stop"),
+        ("I'm easing off a little because the traffic light 30 m ahead is red.", "gentle braking"),
+        ("Here is a poem about the sea.", "does not name the traffic light"),
+    ],
+)
+def test_untrue_explanations_fall_back_and_say_why(
+    openai_server: ScriptedOpenAI, reply: str, why: str
+) -> None:
+    openai_server.script = [("ok", reply)]
+    e = OpenAIExplainer(client(openai_server), TemplateExplainer()).explain(
+        RED, Factor.TRAFFIC_LIGHT
+    )
+    assert e.fallback and e.backend == "embedded"
+    assert (e.error or "").startswith("BackendReplyError: explanation rejected: ")
+    assert why in (e.error or "")
+    assert "30 m" in e.text and "red" in e.text  # the template, true of the state
+
+
+def test_the_remote_model_gets_the_most_urgent_hazard_first(openai_server) -> None:  # type: ignore[no-untyped-def]
+    # a leader 6 m ahead closing at 5 m/s comes before a crossing 42 m ahead
+    rec = StateRecord.model_validate(
+        {
+            "request": "fast",
+            "action": -3,
+            "state": {"v_ego": 10.0, "v_lim": 13.9, "d_lead": 6.0, "dv": 5.0, "d_cross": 42.0},
+        }
+    )
+    openai_server.script = [("ok", "[EXPLAIN]")]
+    d = OpenAIDecider(client(openai_server), RuleDecider()).decide(rec)
+    assert d.factor is Factor.LEAD_VEHICLE
+    message = openai_server.requests[0]["messages"][1]["content"]
+    assert message.index("Vehicle ahead at 6 m") < message.index("Pedestrian crossing")
+    assert message.endswith("Most urgent: the vehicle 6 m ahead (time to collision 1.2 s).")
 
 
 def test_loading_the_openai_stack_loads_the_offline_fallback() -> None:

@@ -77,6 +77,17 @@ class BrakingDecider(ExplanationDecider):
         return Decision(explain, factor, conflict, "test", self.name)
 
 
+class SleepyDecider(BrakingDecider):
+    """:class:`BrakingDecider` that takes ``delay_s`` per decision (a slow remote model)."""
+
+    def __init__(self, delay_s: float) -> None:
+        self.delay_s = delay_s
+
+    def decide(self, record: StateRecord) -> Decision:
+        time.sleep(self.delay_s)
+        return super().decide(record)
+
+
 class EchoExplainer(Explainer):
     name = "fake"
 
@@ -94,11 +105,16 @@ class FileNameTranscriber:
         return Transcript(Path(path).stem.replace("_", " "), 1.0, 0.0, "en")
 
 
-def fake_language(delay_s: float = 0.0) -> LanguageStack:
+def fake_language(
+    delay_s: float = 0.0,
+    decider: ExplanationDecider | None = None,
+    remote_deadline_s: float | None = None,
+) -> LanguageStack:
     return LanguageStack(
         "fake",
         KeywordInterpreter(delay_s),
-        BrakingDecider(),
+        decider or BrakingDecider(),
         EchoExplainer(),
         FileNameTranscriber(),
+        remote_deadline_s,
     )

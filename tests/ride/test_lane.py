@@ -2,6 +2,8 @@
 
 import time
 
+import pytest
+
 from explaindrive.ride.lane import LanguageLane
 
 
@@ -30,5 +32,56 @@ def test_collect_without_wait_keeps_running_tasks():
         assert lane.pending == 1
         (done,) = lane.collect(wait=True)
         assert not done.late and 0.2 <= done.latency_s < 2.0
+    finally:
+        lane.close()
+
+
+def test_explanations_never_delay_interpretation():
+    lane = LanguageLane()
+    try:
+        lane.submit("decide", time.sleep, 1.0, deadline_s=2.0)
+        lane.submit("explain", time.sleep, 1.0, deadline_s=2.0)
+        lane.submit("interpret", lambda: "stop", deadline_s=2.0)
+        time.sleep(0.2)
+        (read,) = lane.collect()
+        assert read.task.kind == "interpret" and read.result == "stop"
+        assert read.latency_s < 0.2  # not behind the 2 s of explanation work
+        assert lane.busy("explanation") and not lane.busy("interpretation")
+    finally:
+        lane.close()
+
+
+def test_lines_are_interpreted_side_by_side():
+    lane = LanguageLane()
+    try:
+        t0 = time.monotonic()
+        for _ in range(3):
+            lane.submit("interpret", time.sleep, 0.5, deadline_s=2.0)
+        outcomes = lane.collect(wait=True)
+        assert len(outcomes) == 3 and not any(o.late for o in outcomes)
+        assert time.monotonic() - t0 < 1.0  # 3 x 0.5 s one after the other would be 1.5 s
+    finally:
+        lane.close()
+
+
+def test_a_late_task_still_running_keeps_its_channel_busy():
+    lane = LanguageLane()
+    try:
+        lane.submit("decide", time.sleep, 0.5, deadline_s=0.1)
+        time.sleep(0.2)
+        (late,) = lane.collect()
+        assert late.late and lane.pending == 0
+        assert lane.busy("explanation")  # its worker is still sleeping
+        time.sleep(0.4)
+        assert not lane.busy("explanation")
+    finally:
+        lane.close()
+
+
+def test_unknown_task_kind_is_refused():
+    lane = LanguageLane()
+    try:
+        with pytest.raises(ValueError, match="unknown language task 'summarise'"):
+            lane.submit("summarise", print, deadline_s=1.0)
     finally:
         lane.close()

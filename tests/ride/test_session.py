@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import time
 
 import pytest
 
@@ -10,9 +11,9 @@ from explaindrive.commands import Command
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.runner import run_ride
 from explaindrive.ride.script import ScriptLine
-from explaindrive.ride.session import RideSession
+from explaindrive.ride.session import RideSession, check_deadlines
 
-from .fakes import ScriptedController, fake_language
+from .fakes import ScriptedController, SleepyDecider, fake_language
 
 
 def make_session(**overrides) -> RideSession:
@@ -130,3 +131,48 @@ def test_typed_yes_waits_for_its_question(tmp_path):
     assert [e["to"] for e in events(session, "confirmed")] == ["stop"]
     assert session.counts.requests == 1  # "yes" was not taken for a new request
     assert session.records[-1].command == "stop"
+
+
+def test_a_later_request_understood_first_wins():
+    """'hurry (slow model)' then 'stop': the stop is read first; the older fast is dropped."""
+    session = make_session(realtime=True, max_steps=20)
+    session.start()
+    session.say("hurry, slow model", confirm="yes")  # read in 0.5 s
+    session.say("stop", confirm="yes")  # read at once, in a worker of its own
+    time.sleep(0.2)
+    session.step()
+    assert session.command is Command.STOP
+    time.sleep(0.5)
+    session.step()
+    session.step()
+    assert session.command is Command.STOP
+    (stale,) = [e for r in session.records for e in r.passenger if e["type"] == "superseded"]
+    assert stale == {"type": "superseded", "id": 1, "by": 2, "t": 1.0}
+    assert (session.counts.superseded, session.counts.confirmations) == (1, 1)
+    session.close()
+
+
+def test_a_slow_decider_skips_decisions_instead_of_queueing_them():
+    cfg = RideConfig(traffic_level=0.5, seed=3, max_steps=20, realtime=True)
+    language = fake_language(decider=SleepyDecider(0.35))
+    session = RideSession(cfg, ScriptedController(), language)
+    session.start()
+    for _ in range(6):
+        session.step()
+        time.sleep(0.2)  # a step every 0.2 s: a decision takes 0.35 s
+    session.close()
+    skipped = [r for r in session.records if r.decision and r.decision.get("skipped")]
+    decided = [r for r in session.records if r.decision and "backend" in r.decision]
+    assert session.counts.skipped_decisions == len(skipped) >= 2
+    assert len(decided) >= 2 and session.counts.late == 0
+
+
+def test_a_remote_deadline_must_leave_room_for_the_fallback():
+    check_deadlines(RideConfig(), None)
+    check_deadlines(RideConfig(), 0.8)  # 0.8 + 0.2 fits the 1 s explanation deadline
+    with pytest.raises(ValueError, match=r"explain_deadline_s \(1 s\)"):
+        check_deadlines(RideConfig(), 0.81)
+    with pytest.raises(ValueError, match=r"interpret_deadline_s \(0\.5 s\)"):
+        check_deadlines(RideConfig(interpret_deadline_s=0.5, explain_deadline_s=2.0), 0.4)
+    with pytest.raises(ValueError, match=r"lower openai\.timeout_s"):
+        RideSession(RideConfig(), ScriptedController(), fake_language(remote_deadline_s=1.5))

@@ -45,7 +45,7 @@ def interpret_command(
         text = transcript.text
     assert text is not None
     result = stack.interpreter.interpret(text)
-    out = result.to_json()
+    out = {**result.to_json(), "latency_s": round(result.latency_s, 4), "error": result.error}
     if transcript is not None:
         out["transcript"] = transcript.text
     if as_json:
@@ -55,6 +55,7 @@ def interpret_command(
         console.print(f"[dim]heard:[/] {transcript.text}", highlight=False)
     intent = out["intent"] or "none"
     note = " [yellow](fallback)[/]" if result.fallback else ""
+    note += " [dim](offline STOP check)[/]" if result.stop_lane else ""
     console.print(f"[bold]{intent}[/] via {result.backend}{note}", highlight=False)
     console.print(str(result.confirmation), highlight=False)
 

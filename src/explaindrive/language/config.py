@@ -78,9 +78,12 @@ class OpenAIConfig(_Strict):
     """``None`` = ``OPENAI_BASE_URL`` or the SDK default."""
     api_key: str | None = None
     """``None`` = ``OPENAI_API_KEY`` (a placeholder is used for local servers without one)."""
-    timeout_s: float = Field(default=1.5, gt=0.0)
-    """[s] per request; on timeout the embedded module answers instead."""
+    timeout_s: float = Field(default=0.8, gt=0.0)
+    """[s] total deadline of one call: connecting, sending, reading and retries. When it
+    passes, the embedded module answers instead. A ride checks that it fits its own
+    deadlines (:data:`explaindrive.ride.session.FALLBACK_MARGIN_S`)."""
     max_retries: int = Field(default=0, ge=0)
+    """Retries after a connection error, HTTP 429 or 5xx, within ``timeout_s``."""
     intent_temperature: float = Field(default=0.0, ge=0.0, le=2.0)
     decision_temperature: float = Field(default=0.0, ge=0.0, le=2.0)
     explain_temperature: float = Field(default=0.2, ge=0.0, le=2.0)

@@ -19,13 +19,19 @@ from explaindrive.language.speech import SpeechToText, Transcriber
 
 @dataclass(frozen=True)
 class LanguageStack:
-    """The four modules the ride loop calls."""
+    """The four modules the ride loop calls.
+
+    Attributes:
+        remote_deadline_s: the total deadline of one call to a remote model [s], after
+            which the embedded module answers; ``None`` when nothing remote is called.
+    """
 
     backend: str
     interpreter: IntentInterpreter
     decider: ExplanationDecider
     explainer: Explainer
     transcriber: SpeechToText
+    remote_deadline_s: float | None = None
 
     def load(self, speech: bool = False) -> LanguageStack:
         """Load the interpreter's model now (and Whisper's with ``speech``); returns self.
@@ -74,4 +80,5 @@ def make_language_stack(
         interpreter = OpenAIIntentInterpreter(client, interpreter)
         decider = OpenAIDecider(client, decider)
         explainer = OpenAIExplainer(client, explainer)
-    return LanguageStack(name, interpreter, decider, explainer, Transcriber(cfg.speech))
+    remote = cfg.openai.timeout_s if name == "openai" else None
+    return LanguageStack(name, interpreter, decider, explainer, Transcriber(cfg.speech), remote)

@@ -1,8 +1,14 @@
 """The language lane: language work off the control path, each task with a deadline.
 
-Tasks run one at a time in a worker thread. The control loop polls for finished
-tasks; a task that misses its deadline is reported as late and its result, if
-it ever comes, is dropped.
+Work runs in two channels of worker threads, so that explanations never delay or starve
+the passenger's requests:
+
+* ``interpretation`` (transcription and LLM-1): several workers, so a line never waits
+  behind an earlier one that a slow model still holds;
+* ``explanation`` (LLM-2 and LLM-3): one worker, its tasks in order.
+
+The control loop polls for finished tasks; a task that misses its deadline is reported
+as late and its result, if it ever comes, is dropped.
 """
 
 from __future__ import annotations
@@ -12,6 +18,17 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
+
+INTERPRETATION = "interpretation"
+EXPLANATION = "explanation"
+CHANNELS: dict[str, str] = {
+    "interpret": INTERPRETATION,
+    "transcribe": INTERPRETATION,
+    "decide": EXPLANATION,
+    "explain": EXPLANATION,
+}
+"""The channel of each kind of task."""
+INTERPRETATION_WORKERS = 4  # lines interpreted at the same time before one has to wait
 
 
 @dataclass
@@ -29,6 +46,11 @@ class Task:
         """Monotonic time after which the task is late."""
         return self.submitted + self.deadline_s
 
+    @property
+    def channel(self) -> str:
+        """The channel the task runs in."""
+        return CHANNELS[self.kind]
+
 
 @dataclass(frozen=True)
 class Outcome:
@@ -42,11 +64,23 @@ class Outcome:
 
 
 class LanguageLane:
-    """Runs language tasks in one worker thread with per-task deadlines."""
+    """Runs language tasks in an interpretation and an explanation channel, with deadlines.
 
-    def __init__(self) -> None:
-        self._pool = cf.ThreadPoolExecutor(max_workers=1, thread_name_prefix="language")
+    Args:
+        interpretation_workers: threads of the interpretation channel.
+    """
+
+    def __init__(self, interpretation_workers: int = INTERPRETATION_WORKERS) -> None:
+        self._pools = {
+            INTERPRETATION: cf.ThreadPoolExecutor(
+                max_workers=interpretation_workers, thread_name_prefix="language-interpret"
+            ),
+            EXPLANATION: cf.ThreadPoolExecutor(
+                max_workers=1, thread_name_prefix="language-explain"
+            ),
+        }
         self._pending: list[Task] = []
+        self._overdue: list[Task] = []  # late tasks whose worker may still be running
 
     @property
     def pending(self) -> int:
@@ -57,6 +91,12 @@ class LanguageLane:
         """Whether a task of ``kind`` is pending."""
         return any(t.kind == kind for t in self._pending)
 
+    def busy(self, channel: str) -> bool:
+        """Whether ``channel`` has a task that is pending or still running after its deadline."""
+        return any(t.channel == channel for t in self._pending) or any(
+            not t.future.done() for t in self._overdue if t.channel == channel
+        )
+
     def submit(
         self,
         kind: str,
@@ -65,9 +105,17 @@ class LanguageLane:
         deadline_s: float,
         context: dict[str, Any] | None = None,
     ) -> Task:
-        """Queue ``fn(*args)``; it must finish within ``deadline_s`` wall seconds."""
+        """Queue ``fn(*args)`` in the channel of ``kind``; it must finish within
+        ``deadline_s`` wall seconds.
+
+        Raises:
+            ValueError: for a kind of task that no channel runs.
+        """
+        if kind not in CHANNELS:
+            raise ValueError(f"unknown language task {kind!r}; expected one of {sorted(CHANNELS)}")
         submitted = time.monotonic()  # before the worker can start
-        task = Task(kind, self._pool.submit(_run, fn, args), submitted, deadline_s, context or {})
+        future = self._pools[CHANNELS[kind]].submit(_run, fn, args)
+        task = Task(kind, future, submitted, deadline_s, context or {})
         self._pending.append(task)
         return task
 
@@ -86,14 +134,10 @@ class LanguageLane:
         keep: list[Task] = []
         for task in self._pending:
             if task.future.done() and not task.future.cancelled():
-                value, error, finished = task.future.result()
-                latency = finished - task.submitted
-                if latency > task.deadline_s:
-                    out.append(Outcome(task, late=True, latency_s=latency))
-                else:
-                    out.append(Outcome(task, result=value, error=error, latency_s=latency))
+                out.append(_finished(task))
             elif now >= task.expires:
-                task.future.cancel()
+                if not task.future.cancel():
+                    self._overdue = [*(t for t in self._overdue if not t.future.done()), task]
                 out.append(Outcome(task, late=True, latency_s=now - task.submitted))
             else:
                 keep.append(task)
@@ -101,11 +145,21 @@ class LanguageLane:
         return out
 
     def close(self) -> None:
-        """Stop the worker (pending work is abandoned)."""
+        """Stop the workers (pending work is abandoned)."""
         for task in self._pending:
             task.future.cancel()
         self._pending = []
-        self._pool.shutdown(wait=False, cancel_futures=True)
+        for pool in self._pools.values():
+            pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _finished(task: Task) -> Outcome:
+    """The outcome of a task whose worker has returned (late if it took too long)."""
+    value, error, finished = task.future.result()
+    latency = finished - task.submitted
+    if latency > task.deadline_s:
+        return Outcome(task, late=True, latency_s=latency)
+    return Outcome(task, result=value, error=error, latency_s=latency)
 
 
 def _run(fn: Callable[..., Any], args: tuple[Any, ...]) -> tuple[Any, str | None, float]:

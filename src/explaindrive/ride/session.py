@@ -34,12 +34,16 @@ from explaindrive.language.intent import IntentResult
 from explaindrive.language.speech import AudioError
 from explaindrive.language.summary import StateRecord
 from explaindrive.ride.config import RideConfig
-from explaindrive.ride.lane import LanguageLane, Outcome
+from explaindrive.ride.lane import EXPLANATION, LanguageLane, Outcome
 
 if TYPE_CHECKING:
     from explaindrive.language.stack import LanguageStack
 
 log = logging.getLogger(__name__)
+
+FALLBACK_MARGIN_S = 0.2
+"""[s] time a language task keeps, after a remote model's deadline, for the embedded
+module to answer instead."""
 
 
 @dataclass
@@ -107,6 +111,8 @@ class RideCounts:
     fallbacks: int = 0
     late: int = 0
     errors: int = 0
+    superseded: int = 0
+    skipped_decisions: int = 0
 
 
 class RideSession:
@@ -117,6 +123,9 @@ class RideSession:
         controller: the merged fast/comfort controller.
         language: the language modules.
         env: an environment to drive (built from ``config`` when omitted).
+
+    Raises:
+        ValueError: if a remote model's deadline does not fit the ride's deadlines.
     """
 
     def __init__(
@@ -126,6 +135,7 @@ class RideSession:
         language: LanguageStack,
         env: UrbanDriveEnv | None = None,
     ) -> None:
+        check_deadlines(config, language.remote_deadline_s)
         self.config = config
         self.controller = controller
         self.language = language
@@ -140,6 +150,7 @@ class RideSession:
         self.records: list[StepRecord] = []
         self.pending_confirmation: _Request | None = None
         self._requests = 0
+        self._newest_read = 0  # the latest request understood as a command
         self._inbox: list[dict[str, Any]] = []  # passenger events of the coming step
         self._obs: NDArray[np.float32] | None = None
         self._last_explained: tuple[str | None, float] = (None, -math.inf)
@@ -268,19 +279,30 @@ class RideSession:
         self._obs = next_obs
         self.done = terminated or truncated
         if command is not Command.STOP or change > 0:
-            state_record = StateRecord.from_observation(obs, change)
-            self.lane.submit(
-                "decide",
-                self.language.decider.decide,
-                state_record,
-                deadline_s=self.config.explain_deadline_s,
-                context={"record": state_record, "step": len(self.records) - 1},
-            )
+            self._submit_decision(record, StateRecord.from_observation(obs, change))
         if self.done:
             self._handle(self.lane.collect(wait=True))
             record.passenger.extend(self._inbox)
             self._inbox = []
         return record
+
+    def _submit_decision(self, record: StepRecord, state_record: StateRecord) -> None:
+        """Ask LLM-2 about this step, unless the explanation channel is still busy.
+
+        A slow model must not build a queue of stale decisions: while the previous
+        decision or explanation is still running, this step goes without one.
+        """
+        if self.lane.busy(EXPLANATION):
+            self.counts.skipped_decisions += 1
+            record.decision = {"explain": False, "skipped": "the explanation channel is busy"}
+            return
+        self.lane.submit(
+            "decide",
+            self.language.decider.decide,
+            state_record,
+            deadline_s=self.config.explain_deadline_s,
+            context={"record": state_record, "step": len(self.records) - 1},
+        )
 
     # ------------------------------------------------------------------ language results
     def _handle(self, outcomes: list[Outcome]) -> None:
@@ -344,7 +366,13 @@ class RideSession:
         if result.intent is None:
             self.counts.rephrase += 1
             return
+        if req.id < self._newest_read:
+            # a later request was understood first: the passenger's last instruction counts
+            self.counts.superseded += 1
+            self._note({"type": "superseded", "id": req.id, "by": self._newest_read})
+            return
         self.counts.understood += 1
+        self._newest_read = req.id
         req.intent, req.question = result.intent, result.confirmation
         if result.intent is Command.STOP and self.config.stop_without_confirm:
             self._resolve(req, True, source="stop-without-confirm")
@@ -448,3 +476,22 @@ class RideSession:
             "final_command": self.controller.command.label,
             "steps": len(self.records),
         }
+
+
+def check_deadlines(config: RideConfig, remote_deadline_s: float | None) -> None:
+    """Check that a remote model's deadline leaves the embedded fallback time in the ride.
+
+    Raises:
+        ValueError: if ``remote_deadline_s`` plus :data:`FALLBACK_MARGIN_S` exceeds the
+            interpretation or the explanation deadline.
+    """
+    if remote_deadline_s is None:
+        return
+    for name in ("interpret_deadline_s", "explain_deadline_s"):
+        ride_s = getattr(config, name)
+        if remote_deadline_s + FALLBACK_MARGIN_S > ride_s:
+            raise ValueError(
+                f"the remote model's deadline (openai.timeout_s {remote_deadline_s:g} s) plus "
+                f"{FALLBACK_MARGIN_S:g} s for the embedded fallback exceeds the ride's {name} "
+                f"({ride_s:g} s); lower openai.timeout_s"
+            )

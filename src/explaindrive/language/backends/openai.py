@@ -1,8 +1,9 @@
 """OpenAI-compatible backend (OpenAI, Ollama, vLLM, llama.cpp) with the paper's prompts.
 
-Every reply is validated (LLM-1 template, LLM-2 tag, LLM-3 grounding); a malformed
-reply, an HTTP error or a timeout falls back to the embedded module and the result
-says so (``fallback=True``, ``error=...``).
+Every reply is validated (LLM-1 template, LLM-2 tag, LLM-3 checked against the state);
+a malformed or untrue reply, an HTTP error or a call past its total deadline falls back
+to the embedded module and the result says so (``fallback=True``, ``error=...``). The
+embedded interpreter reads every request first and answers a STOP itself.
 """
 
 from __future__ import annotations
@@ -13,6 +14,9 @@ import os
 import time
 from typing import Any, TypeVar
 
+from explaindrive.commands import Command
+from explaindrive.language.backends import deadline
+from explaindrive.language.backends.deadline import DeadlineExceededError
 from explaindrive.language.backends.embedded import (
     EmbeddedIntentInterpreter,
     RuleDecider,
@@ -27,7 +31,8 @@ from explaindrive.language.decision import (
     most_critical_factor,
     parse_decision_tag,
 )
-from explaindrive.language.explanation import Explainer, Explanation, check_grounding
+from explaindrive.language.explanation import Explainer, Explanation
+from explaindrive.language.grounding import reply_problems
 from explaindrive.language.intent import IntentInterpreter, IntentResult, parse_confirmation
 from explaindrive.language.summary import StateRecord, describe_action, environment_summary
 from explaindrive.redact import redact
@@ -71,7 +76,6 @@ for the vehicle’s behavior, using a friendly and reassuring tone. Keep
 it concise."""
 
 _REQUEST_TEXT = {"fast": "drive faster", "comfort": "drive more carefully", "stop": "stop"}
-MAX_EXPLANATION_CHARS = 400
 
 
 class BackendReplyError(RuntimeError):
@@ -101,22 +105,47 @@ class ChatClient:
             api_key=self.secret or "not-needed",
             base_url=config.base_url or os.environ.get("OPENAI_BASE_URL") or None,
             timeout=config.timeout_s,
-            max_retries=config.max_retries,
+            max_retries=0,  # retried in complete(), within the call's deadline
+            http_client=deadline.http_client(config.timeout_s),
         )
 
     def complete(self, system: str, user: str, temperature: float) -> str:
-        """One chat completion; returns the reply text.
+        """One chat completion within ``config.timeout_s`` in total; returns the reply text.
+
+        The deadline covers connecting, sending, reading and the retries
+        (``config.max_retries``, for connection errors, HTTP 429 and 5xx).
 
         Raises:
+            DeadlineExceededError: when no complete answer came within the deadline.
             BackendReplyError: on an empty reply.
-            openai.OpenAIError: on HTTP errors and timeouts.
+            openai.OpenAIError: on other HTTP errors.
         """
-        resp: Any = self._client.chat.completions.create(
+        import openai
+
+        end = time.monotonic() + self.config.timeout_s
+        for attempt in range(self.config.max_retries + 1):
+            try:
+                with deadline.until(end):
+                    resp = self._create(system, user, temperature)
+                break
+            except openai.APITimeoutError as exc:
+                raise DeadlineExceededError(
+                    f"no answer within the {self.config.timeout_s:g} s deadline"
+                ) from exc
+            except (openai.APIConnectionError, openai.InternalServerError, openai.RateLimitError):
+                if attempt == self.config.max_retries or time.monotonic() >= end:
+                    raise
+        return self._reply_text(resp)
+
+    def _create(self, system: str, user: str, temperature: float) -> Any:
+        return self._client.chat.completions.create(
             model=self.config.model,
             messages=[{"role": "system", "content": system}, {"role": "user", "content": user}],
             temperature=temperature,
             max_tokens=self.config.max_tokens,
         )
+
+    def _reply_text(self, resp: Any) -> str:
         if not resp.choices or resp.choices[0].message.content is None:
             raise BackendReplyError("empty reply")
         return redact(str(resp.choices[0].message.content), [self.secret])
@@ -153,8 +182,18 @@ class OpenAIIntentInterpreter(IntentInterpreter):
         self.fallback.load()
 
     def interpret(self, text: str) -> IntentResult:
-        """Ask the endpoint; the reply must be exactly the confirmation template."""
+        """Read the request offline for STOP first, then ask the endpoint.
+
+        The embedded interpreter reads every request first (tens of milliseconds). A STOP
+        found there is returned at once (``stop_lane=True``) without asking the endpoint,
+        so a STOP never waits on a remote model. Otherwise the endpoint's reply must be
+        exactly the confirmation template; on any failure, the deadline included, the
+        embedded reading stands in (``fallback=True``).
+        """
         t0 = time.perf_counter()
+        local = self.fallback.interpret(text)
+        if local.intent is Command.STOP:
+            return dataclasses.replace(local, stop_lane=True, latency_s=time.perf_counter() - t0)
         try:
             reply = self.client.complete(INTENT_PROMPT, text, self.client.config.intent_temperature)
             command = parse_confirmation(reply)
@@ -166,7 +205,7 @@ class OpenAIIntentInterpreter(IntentInterpreter):
         except Exception as exc:  # any endpoint failure: answer offline instead
             error = _err(exc, self.client)
             log.warning("openai intent failed, using embedded: %s", error)
-            return _as_fallback(self.fallback.interpret(text), t0, error)
+            return _as_fallback(local, t0, error)
 
 
 class OpenAIDecider(ExplanationDecider):
@@ -218,7 +257,13 @@ class OpenAIExplainer(Explainer):
         self.fallback = fallback
 
     def explain(self, record: StateRecord, factor: Factor | None) -> Explanation:
-        """Ask for an explanation; it must be short and name only factors in the state."""
+        """Ask for an explanation and check it against the state before it is used.
+
+        The reply must pass :func:`~explaindrive.language.grounding.reply_problems` (an
+        explanation naming the factor, no absent factor or invented hazard, the light's
+        true colour, distances and speeds near the state's, wording true of the action);
+        otherwise the template explanation stands in and ``error`` says why.
+        """
         t0 = time.perf_counter()
         cutoff = self.fallback.config.cutoff_m
         factor = factor or most_critical_factor(record, cutoff)
@@ -228,12 +273,9 @@ class OpenAIExplainer(Explainer):
                 situation_message(record, cutoff),
                 self.client.config.explain_temperature,
             ).strip()
-            if not reply or len(reply) > MAX_EXPLANATION_CHARS:
-                raise BackendReplyError(f"explanation empty or too long ({len(reply)} chars)")
-            grounding = check_grounding(reply, None, record, cutoff)
-            if grounding.absent:
-                names = ", ".join(f.value for f in grounding.absent)
-                raise BackendReplyError(f"explanation names factors not in the state: {names}")
+            problems = reply_problems(reply, record, factor, cutoff)
+            if problems:
+                raise BackendReplyError(f"explanation rejected: {'; '.join(problems)}")
             return Explanation(reply, factor, NAME, latency_s=time.perf_counter() - t0)
         except Exception as exc:
             error = _err(exc, self.client)
