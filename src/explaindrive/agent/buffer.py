@@ -2,11 +2,10 @@
 
 A transition may span n steps (n-step returns): ``reward`` is then the discounted sum of
 the n rewards, ``next_obs`` the state n steps later and ``discount`` gamma^n (0 is never
-stored: a terminal transition keeps its ``terminated`` flag). ``mask`` marks the actions of
-``obs`` that learning does not penalise (:func:`explaindrive.agent.shield.training_mask`),
-``next_mask`` the actions of ``next_obs`` the double-DQN target may choose (those the shield
-keeps, :func:`explaindrive.agent.shield.runtime_mask`); both serve learning only and are
-never given to the network.
+stored: a terminal transition keeps its ``terminated`` flag). ``mask`` and ``next_mask`` mark
+the safe actions of ``obs`` and ``next_obs`` (:func:`explaindrive.agent.shield.training_mask`):
+learning pushes the others down in ``obs`` and takes the double-DQN argmax among them in
+``next_obs``. They serve learning only and are never given to the network.
 
 Memory per transition: ``obs`` and ``next_obs`` as float32 (2 x 8 x 4 = 64 B), the action as
 int8 (1 B), the reward and the discount as float32 (8 B), the termination flag as bool

@@ -110,19 +110,17 @@ class TrainConfig:
     max_episode_steps: int | None = None
     """Env step limit per episode; ``None`` keeps the env's default."""
     safe_learning: bool = False
-    """Learn the shield's rule into the network (``docs/agent.md``): act through the shield
-    (:func:`~explaindrive.agent.shield.runtime_mask`), store the safety masks with each
-    transition, take the double-DQN argmax over the actions the shield keeps and push the
-    Q-values of unsafe actions (:func:`~explaindrive.agent.shield.training_mask`, which
-    leaves dilemma-zone braking alone) down to ``unsafe_q``. The masks are never an input
-    of the network."""
+    """Learn the shield's rule into the network (``docs/agent.md``): act through the safety
+    mask (:func:`~explaindrive.agent.shield.training_mask`), store it with each transition,
+    take the double-DQN argmax over safe actions only and push the Q-values of unsafe
+    actions down to ``unsafe_q``. The mask is never an input of the network."""
     unsafe_q: float = -100.0
     """Value the Q-values of unsafe actions are pushed down to (``safe_learning``)."""
     unsafe_loss_weight: float = 1.0
     """Weight of that loss next to the TD loss."""
     shielded_fraction: float = 1.0
-    """Share of the episodes (the first ones) that act through the shield; the rest act on
-    the bare network's choice, still learning from the masks (``safe_learning``)."""
+    """Share of the episodes (the first ones) that act through the safety mask; the rest act
+    on the bare network's choice, still learning from the masks (``safe_learning``)."""
     stop_when_safe: int | None = None
     """End training once this many consecutive finished episodes had no greedy action the
     shield would override and no violation; ``None`` trains all ``episodes``."""

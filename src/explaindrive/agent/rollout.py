@@ -3,7 +3,7 @@
 A worker owns one environment (libsumo runs one simulation per process) and a copy of the
 learner's network, refreshed when the learner sends new weights. Each
 :meth:`RolloutWorker.collect` plays up to ``steps`` environment steps: epsilon-greedy
-actions (through the shield in shielded episodes), the safety masks of every state, n-step
+actions (through the safety mask in shielded episodes), the safety masks of every state, n-step
 transitions, and a summary of every episode that ended; the whole batch goes back to the
 learner at once. When an episode ends the worker starts the one the learner reserved for it
 (:attr:`CollectRequest.start`); without one it stops early.
@@ -175,8 +175,8 @@ class _Running:
     queue: NStepQueue
     rng: np.random.Generator
     obs: np.ndarray
-    mask: np.ndarray  # not penalised in obs
-    allowed: np.ndarray  # kept by the shield in obs
+    mask: np.ndarray  # the safe actions of obs for learning (training_mask)
+    allowed: np.ndarray  # the actions the run-time shield keeps in obs
 
 
 class RolloutWorker:
@@ -251,18 +251,18 @@ class RolloutWorker:
         with torch.no_grad():
             q = self.net(torch.from_numpy(ep.obs[None])).numpy()
         greedy_unsafe = not ep.allowed[int(q[0].argmax())]
-        act_mask = ep.allowed[None] if ep.summary.shielded else None
+        act_mask = ep.mask[None] if ep.summary.shielded else None
         action = int(D3QNLearner.explore(q, epsilon, ep.rng, act_mask)[0])
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         next_obs = np.asarray(next_obs, dtype=np.float32)
-        next_allowed = runtime_mask(next_obs)
+        next_mask = training_mask(next_obs)
         done = bool(terminated or truncated)
         out.transitions += ep.queue.push(
-            ep.obs, action, float(reward), ep.mask, next_obs, next_allowed, bool(terminated), done
+            ep.obs, action, float(reward), ep.mask, next_obs, next_mask, bool(terminated), done
         )
         out.steps += 1
         ep.summary.record(float(reward), info, greedy_unsafe)
-        ep.obs, ep.mask, ep.allowed = next_obs, training_mask(next_obs), next_allowed
+        ep.obs, ep.mask, ep.allowed = next_obs, next_mask, runtime_mask(next_obs)
         if done:
             ep.summary.terminated = bool(terminated)
             ep.summary.ended_at_step = out.steps
