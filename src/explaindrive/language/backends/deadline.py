@@ -65,18 +65,11 @@ def http_modules() -> tuple[Any, Any]:
     return importlib.import_module(client), importlib.import_module(core)
 
 
-@lru_cache(maxsize=1)
-def _transport_class() -> type:
-    """An HTTP transport whose sockets respect the thread's deadline (built once, over the
-    libraries of :func:`http_modules`)."""
-    httpx, httpcore = http_modules()
-    stream_base: Any = httpcore.NetworkStream
-    backend_base: Any = httpcore.NetworkBackend
-    transport_base: Any = httpx.HTTPTransport
+def _stream_class(httpcore: Any) -> type:
+    """A network stream whose every read and write respects the thread's deadline."""
+    base: Any = httpcore.NetworkStream
 
-    class DeadlineStream(stream_base):
-        """A network stream whose every read and write respects the thread's deadline."""
-
+    class DeadlineStream(base):
         def __init__(self, inner: Any) -> None:
             self._inner = inner
 
@@ -98,9 +91,15 @@ def _transport_class() -> type:
         def get_extra_info(self, info: str) -> Any:
             return self._inner.get_extra_info(info)
 
-    class DeadlineBackend(backend_base):
-        """Synchronous sockets, connected and used within the thread's deadline."""
+    return DeadlineStream
 
+
+def _backend_class(httpcore: Any) -> type:
+    """Synchronous sockets, connected and used within the thread's deadline."""
+    base: Any = httpcore.NetworkBackend
+    stream = _stream_class(httpcore)
+
+    class DeadlineBackend(base):
         def __init__(self) -> None:
             self._inner = httpcore.SyncBackend()
 
@@ -113,25 +112,35 @@ def _transport_class() -> type:
             socket_options: Iterable[Any] | None = None,
         ) -> Any:
             bounded = _bounded(timeout, httpcore.ConnectTimeout)
-            stream = self._inner.connect_tcp(host, port, bounded, local_address, socket_options)
-            return DeadlineStream(stream)
+            return stream(
+                self._inner.connect_tcp(host, port, bounded, local_address, socket_options)
+            )
 
         def connect_unix_socket(
             self, path: str, timeout: float | None = None, socket_options: Any = None
         ) -> Any:
             bounded = _bounded(timeout, httpcore.ConnectTimeout)
-            return DeadlineStream(self._inner.connect_unix_socket(path, bounded, socket_options))
+            return stream(self._inner.connect_unix_socket(path, bounded, socket_options))
 
         def sleep(self, seconds: float) -> None:
             self._inner.sleep(seconds)
 
-    class DeadlineTransport(transport_base):
-        """The library's HTTP transport over a pool of :class:`DeadlineBackend` sockets."""
+    return DeadlineBackend
 
+
+@lru_cache(maxsize=1)
+def _transport_class() -> type:
+    """The HTTP library's transport over a pool of deadline-bound sockets (built once, over
+    the libraries of :func:`http_modules`)."""
+    httpx, httpcore = http_modules()
+    base: Any = httpx.HTTPTransport
+    backend = _backend_class(httpcore)
+
+    class DeadlineTransport(base):
         def __init__(self) -> None:
             super().__init__()
             self._pool = httpcore.ConnectionPool(
-                ssl_context=httpx.create_ssl_context(), network_backend=DeadlineBackend()
+                ssl_context=httpx.create_ssl_context(), network_backend=backend()
             )
 
     return DeadlineTransport
