@@ -3,7 +3,7 @@ PY ?= python3.11
 VENV ?= .venv
 BIN := $(VENV)/bin
 
-.PHONY: demo test install dev-install system-deps lint typecheck bench clean
+.PHONY: demo test test-fast install dev-install system-deps lint typecheck bench clean
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
@@ -30,6 +30,10 @@ demo: install
 
 test: dev-install system-deps
 	$(BIN)/python -m pytest
+
+# The quick lane: no model loading, no browser, no slow end-to-end tests.
+test-fast: dev-install
+	$(BIN)/python -m pytest -m "not slow and not browser and not models"
 
 lint:
 	$(BIN)/ruff check src tests benchmarks scripts

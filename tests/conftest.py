@@ -1,4 +1,6 @@
-"""Shared fixtures: a private cache for generated SUMO files, and env construction."""
+"""Shared fixtures (a private cache for generated SUMO files, env construction) and the
+``models`` marker: tests that load Whisper or the sentence encoder, which ``make test-fast``
+leaves out with the ``slow`` and ``browser`` ones."""
 
 from __future__ import annotations
 
@@ -9,6 +11,23 @@ from pathlib import Path
 import pytest
 
 from explaindrive.env.urban_drive import UrbanDriveEnv
+
+MODEL_FIXTURES = frozenset({"interpreter", "mpnet", "transcriber", "speak"})
+MODEL_MODULES = frozenset({
+    "tests/ride/test_ride_shipped.py", "tests/ride/test_stop_lane.py",
+    "tests/language/test_cli.py", "tests/language/test_shipped_models.py",
+    "tests/language/test_onnx_encoder.py", "tests/language/test_openai_backend.py",
+    "tests/web/test_uploads.py",
+})  # fmt: skip
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark the tests that load a model (by their fixtures or their module)."""
+    root = Path(str(config.rootpath))
+    for item in items:
+        module = Path(str(item.path)).relative_to(root).as_posix()
+        if MODEL_FIXTURES & set(getattr(item, "fixturenames", ())) or module in MODEL_MODULES:
+            item.add_marker(pytest.mark.models)
 
 
 @pytest.fixture(scope="session", autouse=True)
