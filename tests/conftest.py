@@ -71,3 +71,20 @@ def without_mpnet(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
 
     monkeypatch.setattr(encoders.metadata, "distribution", missing)
     monkeypatch.setenv("EXPLAINDRIVE_CACHE", str(tmp_path))
+
+
+def mpnet_installed() -> bool:
+    """Whether the optional ``mpnet`` extra (all-mpnet-base-v2) is installed."""
+    from explaindrive.language.encoders import mpnet_part_files
+
+    try:
+        mpnet_part_files()
+    except FileNotFoundError:
+        return False
+    return True
+
+
+needs_mpnet = pytest.mark.skipif(
+    not mpnet_installed(),
+    reason="the optional mpnet extra is not installed (pip install -e '.[mpnet]')",
+)

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from tests.conftest import MPNET_MISSING, mpnet_installed
 
 from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
 from explaindrive.language.config import EmbeddedConfig
@@ -30,7 +31,10 @@ def interpreter() -> EmbeddedIntentInterpreter:
 
 @pytest.fixture(scope="session")
 def mpnet() -> EmbeddedIntentInterpreter:
-    """The embedded LLM-1 over all-mpnet-base-v2, loaded once for the whole session."""
+    """The embedded LLM-1 over all-mpnet-base-v2, loaded once for the whole session (the
+    tests that use it are skipped without the optional mpnet extra)."""
+    if not mpnet_installed():
+        pytest.skip(MPNET_MISSING)
     it = EmbeddedIntentInterpreter(EmbeddedConfig(encoder="mpnet"))
     it.load()
     return it

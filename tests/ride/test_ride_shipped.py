@@ -17,6 +17,7 @@ from explaindrive.ride.config import RideConfig
 from explaindrive.ride.runner import run_ride
 from explaindrive.ride.script import ScriptLine, default_script_path, load_script
 from explaindrive.ride.session import RideSession
+from tests.conftest import needs_mpnet
 
 from ..language.conftest import ScriptedOpenAI
 
@@ -102,6 +103,7 @@ def test_openai_backend_that_times_out_falls_back(tmp_path: Path) -> None:
     assert len(session.records) == 12
 
 
+@needs_mpnet
 def test_ride_with_the_mpnet_encoder_reads_the_default_script(tmp_path: Path) -> None:
     from typer.testing import CliRunner
 
