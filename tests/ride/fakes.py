@@ -26,6 +26,9 @@ class ScriptedController:
         self.command = Command.FAST
         self.active_agent = Command.FAST
         self.driver = CautiousDriver()
+        self.use_shield = False
+        self.last_override = False
+        self.last_network_action: int | None = None
 
     def set_command(self, command: Command | str) -> None:
         cmd = Command.parse(command)

@@ -176,3 +176,29 @@ def test_a_remote_deadline_must_leave_room_for_the_fallback():
         check_deadlines(RideConfig(interpret_deadline_s=0.5, explain_deadline_s=2.0), 0.4)
     with pytest.raises(ValueError, match=r"lower openai\.timeout_s"):
         RideSession(RideConfig(), ScriptedController(), fake_language(remote_deadline_s=1.5))
+
+
+class OverriddenEveryThirdStep(ScriptedController):
+    """Pretends the shield replaced a +3 m/s choice of the network every third step."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.use_shield = True
+        self.steps = 0
+
+    def act(self, obs):  # type: ignore[no-untyped-def]
+        self.steps += 1
+        self.last_override = self.steps % 3 == 0
+        self.last_network_action = 6 if self.last_override else None
+        return super().act(obs)
+
+
+def test_the_event_log_says_when_the_shield_replaced_the_network():
+    cfg = RideConfig(traffic_level=0.5, seed=3, max_steps=9)
+    session = RideSession(cfg, OverriddenEveryThirdStep(), fake_language())
+    session.start()
+    while not session.done:
+        session.step()
+    shields = [r.to_json()["shield"] for r in session.records]
+    assert shields == [None, None, {"replaced": True, "network_action": 3}] * 3
+    assert session.summary()["shield_replacements"] == 3

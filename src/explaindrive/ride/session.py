@@ -76,6 +76,8 @@ class StepRecord:
     decision: dict[str, Any] | None = None
     explanation: dict[str, Any] | None = None
     latency_s: dict[str, float] = field(default_factory=dict)
+    shield: dict[str, Any] | None = None
+    """When the safety shield replaced the network's choice: what the network chose [m/s]."""
 
     def to_json(self) -> dict[str, Any]:
         """JSON-ready dict."""
@@ -93,6 +95,7 @@ class StepRecord:
             "decision": self.decision,
             "explanation": self.explanation,
             "latency_s": self.latency_s,
+            "shield": self.shield,
         }
 
 
@@ -273,6 +276,7 @@ class RideSession:
             },
             passenger=self._inbox,
             latency_s={"policy": policy_s},
+            shield=self._shield_event(),
         )
         self._inbox = []
         self.records.append(record)
@@ -285,6 +289,13 @@ class RideSession:
             record.passenger.extend(self._inbox)
             self._inbox = []
         return record
+
+    def _shield_event(self) -> dict[str, Any] | None:
+        """The shield's intervention in the step just chosen, if it replaced the network."""
+        ctrl = self.controller
+        if not (ctrl.use_shield and ctrl.last_override and ctrl.last_network_action is not None):
+            return None
+        return {"replaced": True, "network_action": speed_change(ctrl.last_network_action)}
 
     def _submit_decision(self, record: StepRecord, state_record: StateRecord) -> None:
         """Ask LLM-2 about this step, unless the explanation channel is still busy.
@@ -475,6 +486,7 @@ class RideSession:
             "counts": self.counts.__dict__.copy(),
             "final_command": self.controller.command.label,
             "steps": len(self.records),
+            "shield_replacements": sum(r.shield is not None for r in self.records),
         }
 
 
