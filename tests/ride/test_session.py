@@ -199,6 +199,7 @@ def test_the_event_log_says_when_the_shield_replaced_the_network():
     session.start()
     while not session.done:
         session.step()
+    session.close()  # libsumo runs one simulation per process: later tests need it free
     shields = [r.to_json()["shield"] for r in session.records]
     assert shields == [None, None, {"replaced": True, "network_action": 3}] * 3
     assert session.summary()["shield_replacements"] == 3
