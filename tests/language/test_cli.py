@@ -39,6 +39,7 @@ def test_explain_json(tmp_path) -> None:  # type: ignore[no-untyped-def]
     assert res.exit_code == 0, res.output
     out = json.loads(res.stdout)
     assert out["explain"] is True and out["factor"] == "pedestrian" and "14 m" in out["text"]
+    assert (out["fallback"], out["errors"]) == (False, [])
     case.write_text("{oops")
     res = runner.invoke(app, ["explain", "--case", str(case)])
     assert res.exit_code == 2 and "not valid JSON" in res.output

@@ -38,16 +38,19 @@ def explain_command(
     decision = stack.decider.decide(record)
     text = None
     fallback = decision.fallback
+    errors = [decision.error] if decision.error else []
     if decision.explain:
         explanation = stack.explainer.explain(record, decision.factor)
         text = explanation.text
         fallback = fallback or explanation.fallback
+        errors += [explanation.error] if explanation.error else []
     out = {
         "explain": decision.explain,
         "factor": decision.factor.value if decision.factor else None,
         "text": text,
         "backend": stack.backend,
         "fallback": fallback,
+        "errors": errors,  # why the remote model was bypassed (a rejected reply says why)
     }
     if as_json:
         emit_json(out)
