@@ -20,11 +20,12 @@ def test_card_describes_the_training(name: str) -> None:
     assert card["evaluation"], "the card carries its evaluation figures"
 
 
+@pytest.mark.parametrize("use_shield", [True, False])
 @pytest.mark.parametrize("name", ["fast", "comfort"])
-def test_shipped_policy_drives_a_short_episode_safely(name: str) -> None:
-    """As shipped: the network through the controller's safety shield."""
+def test_shipped_policy_drives_a_short_episode_safely(name: str, use_shield: bool) -> None:
+    """As shipped (through the controller's shield) and as the bare network."""
     policy = QPolicy.load(shipped_policy_path(name))
-    controller = MergedController(policy, policy, name)
+    controller = MergedController(policy, policy, name, use_shield=use_shield)
     env = UrbanDriveEnv(traffic_level=1.0, max_steps=150)
     metrics = EpisodeMetrics()
     try:
@@ -37,5 +38,5 @@ def test_shipped_policy_drives_a_short_episode_safely(name: str) -> None:
     finally:
         env.close()
     res = metrics.result()
-    assert res.collisions == 0
+    assert res.collisions == res.red_light_runs == res.ped_violations == res.speeding_steps == 0
     assert res.distance_m > 300.0  # it drives, it does not just stand still
