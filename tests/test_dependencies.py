@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import site
 from importlib import metadata
 from pathlib import Path
 
@@ -21,7 +22,10 @@ def allowed() -> set[str]:
 
 
 def test_every_installed_package_is_on_the_allow_list() -> None:
-    installed = {normalize(d.metadata["Name"]) for d in metadata.distributions()}
+    # the environment's site-packages only: Ray puts copies of psutil and colorama that it
+    # carries inside its own package on sys.path when it is imported
+    dists = metadata.distributions(path=site.getsitepackages())
+    installed = {normalize(d.metadata["Name"]) for d in dists}
     unexpected = sorted(installed - allowed() - BOOTSTRAP)
     assert not unexpected, (
         f"installed but not in dependencies.allow: {', '.join(unexpected)}; "
