@@ -139,6 +139,7 @@ def _print_tables(name: str, spec: PolicySpec, records: list[Any], episodes: boo
     """The paper's table, per level, safety, the shield's share and (optionally) episodes."""
     from explaindrive.evaluation import tables
     from explaindrive.evaluation.aggregate import summarize
+    from explaindrive.evaluation.runner import shield_counts
 
     summary = summarize(name, [(r.spec.traffic_level, r.result) for r in records])
     out = Console(highlight=False, markup=False, soft_wrap=True)
@@ -147,8 +148,7 @@ def _print_tables(name: str, spec: PolicySpec, records: list[Any], episodes: boo
     out.print(tables.level_table([summary]) + "\n")
     out.print(tables.safety_table([summary]) + "\n")
     if spec.kind != "baseline":
-        steps = sum(r.result.steps for r in records)
-        overrides = sum(r.shield_overrides for r in records)
+        overrides, steps = shield_counts(records)
         out.print(tables.shield_line(overrides, steps, spec.shield) + "\n")
     if episodes:
         out.print(tables.episode_table(

@@ -23,7 +23,7 @@ from explaindrive.evaluation.paper import (
     PAPER_RESULTS,
     PAPER_STOP_INTERVALS_S,
 )
-from explaindrive.evaluation.runner import EpisodeRecord, Progress, run_grid
+from explaindrive.evaluation.runner import EpisodeRecord, Progress, run_grid, shield_counts
 from explaindrive.evaluation.schema import run_document, write_json
 from explaindrive.evaluation.spec import (
     AGENTS,
@@ -192,8 +192,7 @@ def shield_section(plan: ReportPlan, by_run: Mapping[str, list[EpisodeRecord]]) 
         base = name.split(" ")[0]
         if base not in plan.policies or plan.policies[base].kind == "baseline":
             continue
-        steps = sum(r.result.steps for r in records)
-        overrides = sum(r.shield_overrides for r in records)
+        overrides, steps = shield_counts(records)
         shielded = plan.policies[base].shield
         lines.append(f"- {name}: " + tables.shield_line(overrides, steps, shielded))
     return "\n".join(lines) + "\n" if len(lines) > 3 else ""

@@ -136,6 +136,11 @@ def default_workers(n_episodes: int) -> int:
     return max(1, min(os.cpu_count() or 1, n_episodes))
 
 
+def shield_counts(records: Sequence[EpisodeRecord]) -> tuple[int, int]:
+    """(steps in which the shield replaced the network's action, steps) over ``records``."""
+    return sum(r.shield_overrides for r in records), sum(r.result.steps for r in records)
+
+
 def run_grid(
     specs: Sequence[EpisodeSpec],
     *,

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from explaindrive.evaluation.aggregate import Aggregate, aggregate, mean, pstd
-from explaindrive.evaluation.runner import EpisodeRecord, Progress, run_grid
+from explaindrive.evaluation.runner import EpisodeRecord, Progress, run_grid, shield_counts
 from explaindrive.evaluation.spec import parse_policy, plan_run
 from explaindrive.evaluation.tables import fmt, markdown_table
 
@@ -34,12 +34,8 @@ class SeedResult:
 
 def seed_result(run: str, records: Sequence[EpisodeRecord]) -> SeedResult:
     """Summarise the records of one run."""
-    return SeedResult(
-        run,
-        aggregate([r.result for r in records]),
-        sum(r.result.steps for r in records),
-        sum(r.shield_overrides for r in records),
-    )
+    overrides, steps = shield_counts(records)
+    return SeedResult(run, aggregate([r.result for r in records]), steps, overrides)
 
 
 def evaluate_runs(
