@@ -43,34 +43,41 @@ class PaperRow:
     episodes: int
 
 
+def _row(
+    policy: str,
+    *,
+    steps: tuple[int, ...],
+    speeds_mps: tuple[float, ...],
+    mean_speed_mps: float,
+    avg_headway_s: float,
+    avg_ttc_s: float,
+    avg_jerk_mps3: float | None,
+) -> PaperRow:
+    """A row of the paper's table: per-level values in :data:`TRAFFIC_LEVELS` order; both
+    policies had no collision in 25 episodes."""
+    return PaperRow(
+        policy=policy,
+        steps_by_level=dict(zip(TRAFFIC_LEVELS, steps, strict=True)),
+        speed_by_level_mps=dict(zip(TRAFFIC_LEVELS, speeds_mps, strict=True)),
+        mean_speed_mps=mean_speed_mps,
+        avg_headway_s=avg_headway_s,
+        avg_ttc_s=avg_ttc_s,
+        avg_jerk_mps3=avg_jerk_mps3,
+        collisions=0,
+        episodes=25,
+    )
+
+
 PAPER_RESULTS: dict[str, PaperRow] = {
-    "fast": PaperRow(
-        policy="fast",
-        steps_by_level=dict(zip(TRAFFIC_LEVELS, (253, 323, 386, 401, 397), strict=True)),
-        speed_by_level_mps=dict(
-            zip(TRAFFIC_LEVELS, (6.087, 4.767, 3.982, 3.825, 3.879), strict=True)
-        ),
-        mean_speed_mps=4.508,
-        avg_headway_s=2.998,
-        avg_ttc_s=5.603,
-        avg_jerk_mps3=None,
-        collisions=0,
-        episodes=25,
+    "fast": _row(
+        "fast", steps=(253, 323, 386, 401, 397), speeds_mps=(6.087, 4.767, 3.982, 3.825, 3.879),
+        mean_speed_mps=4.508, avg_headway_s=2.998, avg_ttc_s=5.603, avg_jerk_mps3=None,
     ),
-    "comfort": PaperRow(
-        policy="comfort",
-        steps_by_level=dict(zip(TRAFFIC_LEVELS, (257, 333, 398, 416, 405), strict=True)),
-        speed_by_level_mps=dict(
-            zip(TRAFFIC_LEVELS, (5.996, 4.617, 3.869, 3.699, 3.800), strict=True)
-        ),
-        mean_speed_mps=4.396,
-        avg_headway_s=6.373,
-        avg_ttc_s=5.460,
-        avg_jerk_mps3=0.205,
-        collisions=0,
-        episodes=25,
+    "comfort": _row(
+        "comfort", steps=(257, 333, 398, 416, 405), speeds_mps=(5.996, 4.617, 3.869, 3.699, 3.800),
+        mean_speed_mps=4.396, avg_headway_s=6.373, avg_ttc_s=5.460, avg_jerk_mps3=0.205,
     ),
-}
+}  # fmt: skip
 
 
 def paper_row(policy: str) -> PaperRow | None:
