@@ -1,12 +1,27 @@
-"""Options shared by ``explaindrive evaluate``, ``report`` and ``train``: one place each."""
+"""Options and helpers shared by ``explaindrive evaluate``, ``report`` and ``train``: one
+place each."""
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+from explaindrive.cli._errors import error_line
+from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
+
+if TYPE_CHECKING:
+    from explaindrive.evaluation.runner import Progress as EpisodeProgress
+
+err_console = Console(stderr=True)
+
+DEFAULT_TRAFFIC = ",".join(f"{x:g}" for x in TRAFFIC_LEVELS)
 
 FastPolicyOption = Annotated[
     Path | None, typer.Option("--fast-policy", help="Fast policy file instead of the shipped.")
@@ -45,3 +60,29 @@ def check_ray_target(ray: bool, ray_address: str | None) -> str | None:
 
         return RAY_MISSING
     return None
+
+
+def progress_bar() -> Progress:
+    """The episode progress bar (on stderr, so stdout keeps only the tables)."""
+    return Progress(
+        TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+        TimeElapsedColumn(), console=err_console, transient=True,
+    )  # fmt: skip
+
+
+@contextlib.contextmanager
+def episode_progress(description: str, total: int) -> Iterator[EpisodeProgress]:
+    """A progress bar over ``total`` episodes; yields the callback that advances it.
+
+    A policy that cannot load or an episode that fails inside the block ends the command
+    with one line and exit status 1.
+    """
+    from explaindrive.agent.checkpoint import CheckpointError
+
+    try:
+        with progress_bar() as bar:
+            task = bar.add_task(description, total=total)
+            yield lambda done, _total: bar.update(task, completed=done)
+    except (CheckpointError, RuntimeError) as exc:
+        err_console.print(error_line(exc))
+        raise typer.Exit(1) from None

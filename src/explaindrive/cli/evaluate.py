@@ -7,40 +7,16 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from explaindrive.cli import _grid_options as grid
 from explaindrive.cli._errors import error_line
-from explaindrive.cli._grid_options import (
-    ComfortPolicyOption,
-    FastPolicyOption,
-    JsonOption,
-    MaxStepsOption,
-    RayAddressOption,
-    RayOption,
-    ShieldOption,
-    TrafficOption,
-    WorkersOption,
-    check_ray_target,
-)
+from explaindrive.cli._grid_options import err_console
 from explaindrive.evaluation.paper import PAPER_SEEDS
-from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 if TYPE_CHECKING:
     from explaindrive.evaluation.spec import PolicySpec, RunPlan
 
-console = Console()
-err_console = Console(stderr=True)
-
 DEFAULT_SEEDS = f"{PAPER_SEEDS[0]}-{PAPER_SEEDS[-1]}"
-DEFAULT_TRAFFIC = ",".join(f"{x:g}" for x in TRAFFIC_LEVELS)
-
-
-def progress_bar() -> Progress:
-    """The episode progress bar (on stderr, so stdout keeps only the tables)."""
-    return Progress(
-        TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-        TimeElapsedColumn(), console=err_console, transient=True,
-    )  # fmt: skip
 
 
 PolicyArgument = Annotated[
@@ -67,18 +43,18 @@ EpisodesOption = Annotated[
 def evaluate_command(
     policy: PolicyArgument,
     seeds: SeedsOption = DEFAULT_SEEDS,
-    traffic: TrafficOption = DEFAULT_TRAFFIC,
+    traffic: grid.TrafficOption = grid.DEFAULT_TRAFFIC,
     stop_schedule: StopScheduleOption = None,
     commands: CommandsOption = None,
-    json_file: JsonOption = None,
+    json_file: grid.JsonOption = None,
     figures: FiguresOption = None,
-    workers: WorkersOption = None,
-    ray: RayOption = False,
-    ray_address: RayAddressOption = None,
-    max_steps: MaxStepsOption = 1000,
-    fast_policy: FastPolicyOption = None,
-    comfort_policy: ComfortPolicyOption = None,
-    shield: ShieldOption = True,
+    workers: grid.WorkersOption = None,
+    ray: grid.RayOption = False,
+    ray_address: grid.RayAddressOption = None,
+    max_steps: grid.MaxStepsOption = 1000,
+    fast_policy: grid.FastPolicyOption = None,
+    comfort_policy: grid.ComfortPolicyOption = None,
+    shield: grid.ShieldOption = True,
     episodes: EpisodesOption = True,
 ) -> None:
     """Evaluate a policy or a SUMO baseline; prints Markdown tables in the paper's layout."""
@@ -102,7 +78,7 @@ def evaluate_command(
     except SpecError as exc:
         err_console.print(error_line(exc))
         raise typer.Exit(2) from None
-    if (problem := check_ray_target(ray, ray_address)) is not None:
+    if (problem := grid.check_ray_target(ray, ray_address)) is not None:
         err_console.print(error_line(problem))
         raise typer.Exit(2)
     records = _run(plan, workers, ray, ray_address)
@@ -118,21 +94,14 @@ def evaluate_command(
 def _run(plan: RunPlan, workers: int | None, ray: bool, ray_address: str | None) -> list[Any]:
     """Run the grid with a progress bar; a policy that cannot load or an episode that fails
     ends the command with one line."""
-    from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.evaluation.runner import run_grid
 
     n = len(plan.episodes)
     err_console.print(f"evaluating [bold]{plan.name}[/bold]: {n} episode(s)")
-    try:
-        with progress_bar() as bar:
-            task = bar.add_task(plan.name, total=n)
-            return run_grid(
-                plan.episodes, workers=workers, use_ray=ray, ray_address=ray_address,
-                progress=lambda done, _total: bar.update(task, completed=done),
-            )  # fmt: skip
-    except (CheckpointError, RuntimeError) as exc:
-        err_console.print(error_line(exc))
-        raise typer.Exit(1) from None
+    with grid.episode_progress(plan.name, n) as progress:
+        return run_grid(
+            plan.episodes, workers=workers, use_ray=ray, ray_address=ray_address, progress=progress
+        )
 
 
 def _print_tables(name: str, spec: PolicySpec, records: list[Any], episodes: bool) -> None:

@@ -9,20 +9,9 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from explaindrive.cli import _grid_options as grid
 from explaindrive.cli._errors import error_line
-from explaindrive.cli._grid_options import (
-    ComfortPolicyOption,
-    FastPolicyOption,
-    JsonOption,
-    MaxStepsOption,
-    RayAddressOption,
-    RayOption,
-    ShieldOption,
-    TrafficOption,
-    WorkersOption,
-    check_ray_target,
-)
-from explaindrive.cli.evaluate import DEFAULT_TRAFFIC, err_console, progress_bar
+from explaindrive.cli._grid_options import err_console
 from explaindrive.evaluation.spec import POLICY_NAMES
 
 if TYPE_CHECKING:
@@ -59,40 +48,33 @@ def report_command(
     out: OutOption = Path("docs/results.md"),
     figures: FigureDirOption = None,
     episodes_per_cell: EpisodesPerCellOption = 5,
-    traffic: TrafficOption = DEFAULT_TRAFFIC,
+    traffic: grid.TrafficOption = grid.DEFAULT_TRAFFIC,
     policies: PoliciesOption = ALL_POLICIES,
-    fast_policy: FastPolicyOption = None,
-    comfort_policy: ComfortPolicyOption = None,
-    shield: ShieldOption = True,
+    fast_policy: grid.FastPolicyOption = None,
+    comfort_policy: grid.ComfortPolicyOption = None,
+    shield: grid.ShieldOption = True,
     runs_dir: RunsOption = None,
-    json_file: JsonOption = None,
-    workers: WorkersOption = None,
-    ray: RayOption = False,
-    ray_address: RayAddressOption = None,
-    max_steps: MaxStepsOption = 1000,
+    json_file: grid.JsonOption = None,
+    workers: grid.WorkersOption = None,
+    ray: grid.RayOption = False,
+    ray_address: grid.RayAddressOption = None,
+    max_steps: grid.MaxStepsOption = 1000,
     seed_tables: SeedTableOption = None,
 ) -> None:
     """Evaluate the policies and baselines and rewrite the results document and figures."""
-    from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.evaluation.report import run_report
 
     plan = _plan(policies, episodes_per_cell, traffic, fast_policy, comfort_policy, max_steps,
                  shield, ray, ray_address, seed_tables or [])  # fmt: skip
     n = sum(len(run.episodes) for run in plan.runs)
     err_console.print(f"report: {len(plan.runs)} runs, {n} episodes")
-    try:
-        with progress_bar() as bar:
-            task = bar.add_task("episodes", total=n)
-            result = run_report(
-                plan, out, figures_dir=figures, training_runs=_training_logs(plan, runs_dir),
-                json_file=json_file, workers=workers, use_ray=ray, ray_address=ray_address,
-                command_line="explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
-                progress=lambda done, _total: bar.update(task, completed=done),
-                seed_tables=seed_tables or [],
-            )  # fmt: skip
-    except (CheckpointError, RuntimeError) as exc:
-        err_console.print(error_line(exc))
-        raise typer.Exit(1) from None
+    with grid.episode_progress("episodes", n) as progress:
+        result = run_report(
+            plan, out, figures_dir=figures, training_runs=_training_logs(plan, runs_dir),
+            json_file=json_file, workers=workers, use_ray=ray, ray_address=ray_address,
+            command_line="explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
+            progress=progress, seed_tables=seed_tables or [],
+        )  # fmt: skip
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(result.markdown, encoding="utf-8")
     for path in (out, *result.figures):
@@ -108,7 +90,7 @@ def _plan(
     from explaindrive.evaluation.report import parse_policy_list, plan_report
     from explaindrive.evaluation.spec import SpecError, parse_levels
 
-    problem = check_ray_target(ray, ray_address)
+    problem = grid.check_ray_target(ray, ray_address)
     missing = [p for p in seed_tables if not p.is_file()]
     if problem is None and missing:
         problem = f"seed table not found: {missing[0]}"
