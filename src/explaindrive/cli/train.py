@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -20,6 +20,9 @@ from explaindrive.agent.config import (
 )
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import check_ray_target
+
+if TYPE_CHECKING:
+    from explaindrive.agent.trainer import TrainResult
 
 console = Console()
 
@@ -68,50 +71,62 @@ def resolve_config(
     return build_config(preset or "safe", config_file, changes)
 
 
+ModeOption = Annotated[str, typer.Option("--mode", "-m", help="Agent to train: fast or comfort.")]
+EpisodesOption = Annotated[int | None, typer.Option("--episodes", "-n", help="Training episodes.")]
+EnvsOption = Annotated[
+    int | None, typer.Option("--envs", help="Parallel SUMO processes (default: CPU count).")
+]
+OutOption = Annotated[
+    Path | None, typer.Option("--out", "-o", help="Run directory (default: runs/<mode>).")
+]
+ResumeOption = Annotated[
+    bool, typer.Option("--resume", help="Continue from the run's last checkpoint.")
+]
+PresetOption = Annotated[
+    str | None,
+    typer.Option("--preset", help="safe or paper (default: safe; the run's own on --resume)."),
+]
+SeedOption = Annotated[int | None, typer.Option("--seed", help="Base seed of the run.")]
+ConfigFileOption = Annotated[
+    Path | None, typer.Option("--config", help="YAML/JSON file of config values.")
+]
+SetOption = Annotated[
+    list[str] | None,
+    typer.Option("--set", help="Override any config field: --set lr=3e-4 (repeatable)."),
+]
+ProgressOption = Annotated[
+    bool, typer.Option("--progress/--no-progress", help="Show a progress bar.")
+]
+WorkerRayOption = Annotated[
+    bool, typer.Option("--ray", help="Run the env workers as actors on a local Ray.")
+]
+WorkerRayAddressOption = Annotated[
+    str | None, typer.Option("--ray-address", help="Run the env workers on this Ray cluster.")
+]
+SeedsOption = Annotated[
+    str | None,
+    typer.Option(
+        "--seeds",
+        help="Train one run per seed side by side (e.g. 0,1,2), then evaluate each "
+        "on the same grid (see docs/agent.md).",
+    ),
+]
+
+
 def train_command(
-    mode: Annotated[str, typer.Option("--mode", "-m", help="Agent to train: fast or comfort.")],
-    episodes: Annotated[
-        int | None, typer.Option("--episodes", "-n", help="Training episodes.")
-    ] = None,
-    envs: Annotated[
-        int | None, typer.Option("--envs", help="Parallel SUMO processes (default: CPU count).")
-    ] = None,
-    out: Annotated[
-        Path | None, typer.Option("--out", "-o", help="Run directory (default: runs/<mode>).")
-    ] = None,
-    resume: Annotated[
-        bool, typer.Option("--resume", help="Continue from the run's last checkpoint.")
-    ] = False,
-    preset: Annotated[
-        str | None,
-        typer.Option("--preset", help="safe or paper (default: safe; the run's own on --resume)."),
-    ] = None,
-    seed: Annotated[int | None, typer.Option("--seed", help="Base seed of the run.")] = None,
-    config_file: Annotated[
-        Path | None, typer.Option("--config", help="YAML/JSON file of config values.")
-    ] = None,
-    overrides: Annotated[
-        list[str] | None,
-        typer.Option("--set", help="Override any config field: --set lr=3e-4 (repeatable)."),
-    ] = None,
-    progress: Annotated[
-        bool, typer.Option("--progress/--no-progress", help="Show a progress bar.")
-    ] = True,
-    ray: Annotated[
-        bool, typer.Option("--ray", help="Run the env workers as actors on a local Ray.")
-    ] = False,
-    ray_address: Annotated[
-        str | None,
-        typer.Option("--ray-address", help="Run the env workers on this Ray cluster."),
-    ] = None,
-    seeds: Annotated[
-        str | None,
-        typer.Option(
-            "--seeds",
-            help="Train one run per seed side by side (e.g. 0,1,2), then evaluate each "
-            "on the same grid (see docs/agent.md).",
-        ),
-    ] = None,
+    mode: ModeOption,
+    episodes: EpisodesOption = None,
+    envs: EnvsOption = None,
+    out: OutOption = None,
+    resume: ResumeOption = False,
+    preset: PresetOption = None,
+    seed: SeedOption = None,
+    config_file: ConfigFileOption = None,
+    overrides: SetOption = None,
+    progress: ProgressOption = True,
+    ray: WorkerRayOption = False,
+    ray_address: WorkerRayAddressOption = None,
+    seeds: SeedsOption = None,
 ) -> None:
     """Train a D3QN driving agent with the paper's command schedule."""
     from explaindrive.agent.checkpoint import CheckpointError
@@ -139,8 +154,12 @@ def train_command(
         f"training [bold]{config.mode}[/bold]: {config.episodes} episodes on {config.envs} "
         f"env(s) -> {out}"
     )
-    result = trainer.run()
-    table = Table(title=f"{config.mode} agent trained", show_header=False)
+    _print_result(config.mode, trainer.run())
+
+
+def _print_result(mode: str, result: TrainResult) -> None:
+    """The finished run's figures and files, as a table."""
+    table = Table(title=f"{mode} agent trained", show_header=False)
     for key, value in (
         ("episodes", result.episodes),
         ("env steps", result.env_steps),
