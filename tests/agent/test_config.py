@@ -1,9 +1,12 @@
-"""Config validation, presets, files and overrides."""
+"""Config validation, presets, files, overrides and the saved configs."""
 
 from __future__ import annotations
 
 import json
+import re
+from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -15,6 +18,15 @@ from explaindrive.agent.config import (
     parse_override,
     preset,
 )
+from explaindrive.cli.train import resolve_config
+
+SHIPPED_POLICIES = ("fast", "comfort")
+
+
+def _card_config(name: str) -> dict[str, Any]:
+    card = resources.files("explaindrive.agent") / "policies" / f"{name}.json"
+    config: dict[str, Any] = json.loads(card.read_text(encoding="utf-8"))["config"]
+    return config
 
 
 def test_paper_preset_holds_the_paper_values() -> None:
@@ -41,28 +53,73 @@ def test_safe_preset_is_shorter_and_learns_the_shield() -> None:
 def test_unknown_preset_and_key_are_rejected() -> None:
     with pytest.raises(ConfigError, match="unknown preset 'slow'"):
         preset("slow")
-    with pytest.raises(ConfigError, match=r"unknown config key.*lr_rate"):
+    with pytest.raises(ConfigError) as err:
         TrainConfig.from_dict({"lr_rate": 0.1})
+    message = str(err.value)
+    assert message.startswith("unknown training config key(s): lr_rate; known keys: batch_size,")
+    assert "invalid" not in message  # nothing else is wrong
+    with pytest.raises(ConfigError, match=r"^unknown training config key\(s\): lr_rate; "):
+        TrainConfig(lr_rate=0.1)  # type: ignore[call-arg]
+    with pytest.raises(ConfigError, match=r"^unknown training config key\(s\): lr_rate; "):
+        PAPER.replace(lr_rate=0.1)
+
+
+def test_unknown_keys_and_bad_values_are_reported_together() -> None:
+    with pytest.raises(ConfigError) as err:
+        TrainConfig.from_dict({"batchsize": 32, "episodes": 0, "gamma": 1.5})
+    message = str(err.value)
+    assert message.startswith("unknown training config key(s): batchsize; known keys: ")
+    assert message.endswith(
+        "; invalid training config: episodes: Input should be greater than 0, got 0; "
+        "gamma: Input should be less than 1, got 1.5"
+    )
 
 
 @pytest.mark.parametrize(
     ("changes", "message"),
     [
-        ({"mode": "stop"}, "stop is not a training mode"),
-        ({"mode": "sporty"}, "mode must be one of fast, comfort"),
-        ({"gamma": 1.0}, "gamma must be in"),
-        ({"batch_size": 0}, "batch_size must be > 0"),
-        ({"tau": 0.0}, "tau must be in"),
-        ({"stop_gap_s": [10, 5]}, "stop_gap_s must be"),
-        ({"hidden_sizes": []}, "hidden_sizes"),
-        ({"lr": "fast"}, "'lr' must be a number"),
-        ({"episodes": 2.5}, "'episodes' must be an integer"),
-        ({"save_replay": 1}, "'save_replay' must be true/false"),
-        ({"stop_gap_s": [1, 2, 3]}, "must have 2 items"),
+        (
+            {"mode": "stop"},
+            "mode: must be one of fast, comfort, got 'stop' "
+            "(stop is not a training mode: both agents learn it)",
+        ),
+        ({"mode": "sporty"}, "mode: must be one of fast, comfort, got 'sporty'"),
+        ({"loss": "l1"}, "loss: must be one of mse, huber, got 'l1'"),
+        ({"gamma": 1.0}, "gamma: Input should be less than 1, got 1.0"),
+        ({"gamma": -0.1}, "gamma: Input should be greater than or equal to 0, got -0.1"),
+        ({"batch_size": 0}, "batch_size: Input should be greater than 0, got 0"),
+        ({"num_envs": 0}, "num_envs: Input should be greater than 0, got 0"),
+        ({"tau": 0.0}, "tau: Input should be greater than 0, got 0.0"),
+        ({"eps_final": 1.5}, "eps_final: Input should be less than or equal to 1, got 1.5"),
+        ({"learning_starts": -1}, "learning_starts: Input should be greater than or equal to 0"),
+        (
+            {"stop_gap_s": [10, 5]},
+            "stop_gap_s: must be [min, max] with 0 < min <= max, got [10.0, 5.0]",
+        ),
+        ({"stop_gap_s": [1, 2, 3]}, "stop_gap_s: Tuple should have at most 2 items"),
+        ({"hidden_sizes": []}, "hidden_sizes: Value should have at least 1 item"),
+        ({"hidden_sizes": [64, 0]}, "hidden_sizes.1: Input should be greater than 0, got 0"),
+        ({"hidden_sizes": [64, 32.0]}, "hidden_sizes.1: Input should be a valid integer"),
+        ({"traffic_levels": []}, "traffic_levels: Value should have at least 1 item"),
+        (
+            {"traffic_levels": [0.5, 2.0]},
+            "traffic_levels.1: traffic level must be at most 1.75, got 2",
+        ),
+        ({"seed": -1}, "seed: seed must be an integer in [0, 2**31), got -1"),
+        ({"lr": "fast"}, "lr: Input should be a valid number, got 'fast'"),
+        ({"lr": float("nan")}, "lr: Input should be a finite number, got nan"),
+        ({"episodes": 2.5}, "episodes: Input should be a valid integer, got 2.5"),
+        ({"episodes": 2.0}, "episodes: Input should be a valid integer, got 2.0"),
+        ({"episodes": "20"}, "episodes: Input should be a valid integer, got '20'"),
+        ({"episodes": True}, "episodes: Input should be a valid integer, got True"),
+        ({"save_replay": 1}, "save_replay: Input should be a valid boolean, got 1"),
+        ({"save_replay": "yes"}, "save_replay: Input should be a valid boolean, got 'yes'"),
+        ({"mode": 1}, "mode: Input should be a valid string, got 1"),
+        ({"batch_size": 128, "buffer_size": 64}, "batch_size (128) exceeds buffer_size (64)"),
     ],
 )
-def test_invalid_values_are_rejected(changes: dict, message: str) -> None:
-    with pytest.raises(ConfigError, match=message):
+def test_invalid_values_are_rejected(changes: dict[str, Any], message: str) -> None:
+    with pytest.raises(ConfigError, match="^invalid training config: .*" + re.escape(message)):
         PAPER.replace(**changes)
 
 
@@ -71,7 +128,7 @@ def test_overrides_are_parsed_as_yaml_and_coerced() -> None:
     assert parse_override("hidden_sizes=[64, 32]") == ("hidden_sizes", [64, 32])
     c = build_config("paper", overrides=dict([parse_override("hidden_sizes=[64, 32]")]))
     assert c.hidden_sizes == (64, 32)
-    assert PAPER.replace(lr=1).lr == 1.0
+    assert PAPER.replace(lr=1).lr == 1.0 and isinstance(PAPER.replace(lr=1).lr, float)
     with pytest.raises(ConfigError, match="key=value"):
         parse_override("lr")
 
@@ -83,7 +140,7 @@ def test_config_file_then_overrides(tmp_path: Path) -> None:
     assert (c.batch_size, c.loss, c.lr) == (16, "huber", 1e-3)
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"batchsize": 32}))
-    with pytest.raises(ConfigError, match="batchsize"):
+    with pytest.raises(ConfigError, match=r"unknown training config key\(s\): batchsize"):
         build_config("safe", bad)
     with pytest.raises(ConfigError, match="cannot read config file"):
         build_config("safe", tmp_path / "missing.yaml")
@@ -97,7 +154,39 @@ def test_json_round_trip() -> None:
 
 def test_exponent_without_dot_is_a_number(tmp_path: Path) -> None:
     f = tmp_path / "c.yaml"
-    f.write_text("lr: 3e-4\n")  # YAML 1.1 reads this as a string
-    assert build_config("safe", f).lr == pytest.approx(3e-4)
-    with pytest.raises(ConfigError, match="'lr' must be a number"):
+    f.write_text("lr: 3e-4\nlr_final: 1E-5\n")  # YAML 1.1 reads these as strings
+    c = build_config("safe", f)
+    assert (c.lr, c.lr_final) == (pytest.approx(3e-4), pytest.approx(1e-5))
+    assert parse_override("eps_end=5e-2") == ("eps_end", 0.05)
+    # an integer field still takes only integers: 1e6 is a float
+    with pytest.raises(
+        ConfigError, match=r"buffer_size: Input should be a valid integer, got 1000000.0"
+    ):
+        build_config("safe", overrides=dict([parse_override("buffer_size=1e6")]))
+    with pytest.raises(ConfigError, match="lr: Input should be a valid number, got 'nan'"):
         build_config("safe", overrides={"lr": "nan"})
+
+
+def test_configs_are_frozen() -> None:
+    with pytest.raises(ValueError, match="frozen"):
+        PAPER.lr = 0.1  # type: ignore[misc]
+    assert PAPER.lr == 1e-3
+
+
+@pytest.mark.parametrize("name", SHIPPED_POLICIES)
+def test_shipped_cards_load_exactly(name: str) -> None:
+    saved = _card_config(name)
+    c = TrainConfig.from_dict(saved)
+    assert c.to_dict() == saved
+    # the same JSON, down to integers staying integers and floats floats
+    assert c.to_json() == json.dumps(saved, indent=2, sort_keys=True)
+    assert c == preset("safe").replace(mode=name, num_envs=saved["num_envs"], seed=saved["seed"])
+
+
+@pytest.mark.parametrize("name", SHIPPED_POLICIES)
+def test_resume_reads_the_saved_config_back_unchanged(name: str, tmp_path: Path) -> None:
+    saved = _card_config(name)
+    (tmp_path / "config.json").write_text(json.dumps(saved, indent=2, sort_keys=True))
+    resumed = resolve_config(name, None, None, [], tmp_path, True)
+    assert resumed == TrainConfig.from_dict(saved)
+    assert resumed.to_dict() == saved

@@ -1,113 +1,126 @@
 """Typed, validated training configuration and its two presets.
 
-One frozen dataclass, :class:`TrainConfig`, holds every knob of the D3QN agent and of its
+One frozen model, :class:`TrainConfig`, holds every knob of the D3QN agent and of its
 training loop. It is built from a preset (``paper`` or ``safe``), then optionally from a
 YAML/JSON file and from ``key=value`` overrides; unknown keys and ill-typed values are
-rejected with a message naming the key. The resolved config is saved as JSON next to
-every checkpoint and inside every policy card.
+rejected with a message naming the key (:class:`~explaindrive.config.ConfigModel`). The
+resolved config is saved as JSON next to every checkpoint and inside every policy card.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
-import re
-import types
-import typing
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import yaml
+from pydantic import (
+    Field,
+    NonNegativeFloat,
+    NonNegativeInt,
+    PositiveFloat,
+    PositiveInt,
+    field_validator,
+    model_validator,
+)
 
 from explaindrive.commands import Command
-from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS, validate_traffic_level
-
-_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+from explaindrive.config import (
+    FROM_LIST,
+    ConfigError,
+    ConfigModel,
+    Seed,
+    TrafficLevel,
+    one_of,
+    read_yaml,
+)
+from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 TRAIN_MODES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
 LOSSES: tuple[str, ...] = ("mse", "huber")
 SEED_POOL_BASE = 100_000  # training seeds from a pool start here, clear of evaluation seeds
 
+Fraction = Annotated[float, Field(ge=0.0, le=1.0)]
+Range = Annotated[tuple[float, float], FROM_LIST]
 
-class ConfigError(ValueError):
-    """A configuration value, key or file is invalid."""
 
-
-@dataclass(frozen=True)
-class TrainConfig:
+class TrainConfig(ConfigModel):
     """Everything that defines one training run of a D3QN driving agent.
 
     Step counts (``*_steps``, ``learning_starts``, ``train_frequency``) are counted in
     environment transitions summed over all parallel environments.
     """
 
+    config_name = "training config"
+
     mode: str = "fast"
     """Primary command the agent is trained for: ``fast`` or ``comfort`` (both learn stop)."""
-    episodes: int = 11_000
+    episodes: PositiveInt = 11_000
     """Number of training episodes (the paper: 11,000)."""
-    num_envs: int | None = None
+    num_envs: PositiveInt | None = None
     """Parallel SUMO processes; ``None`` means ``os.cpu_count()``."""
-    seed: int = 0
+    seed: Seed = 0
     """Base seed of the run: episode seeds, exploration and network initialisation."""
 
-    hidden_sizes: tuple[int, ...] = (128, 128)
+    hidden_sizes: Annotated[tuple[PositiveInt, ...], FROM_LIST, Field(min_length=1)] = (128, 128)
     """Widths of the shared fully connected layers (the paper: two of 128)."""
-    lr: float = 1e-3
+    lr: PositiveFloat = 1e-3
     """Adam learning rate (the paper: 1e-3)."""
-    lr_final: float | None = None
+    lr_final: PositiveFloat | None = None
     """If set, the learning rate decays linearly to this value over ``lr_decay_steps``."""
-    lr_decay_steps: int = 1_000_000
+    lr_decay_steps: PositiveInt = 1_000_000
     """Transitions over which the learning rate decays to ``lr_final``."""
-    loss: str = "mse"
+    loss: Annotated[str, one_of(LOSSES)] = "mse"
     """TD loss: ``mse`` (the paper) or ``huber``."""
-    huber_delta: float = 1.0
+    huber_delta: PositiveFloat = 1.0
     """Threshold of the Huber loss (only with ``loss="huber"``)."""
-    grad_clip_norm: float | None = None
+    grad_clip_norm: PositiveFloat | None = None
     """Max global gradient norm; ``None`` disables clipping."""
-    buffer_size: int = 5_000_000
+    buffer_size: PositiveInt = 5_000_000
     """Replay capacity in transitions (the paper: 5M)."""
-    batch_size: int = 64
+    batch_size: PositiveInt = 64
     """Minibatch size (the paper: 64)."""
-    gamma: float = 0.99
+    gamma: float = Field(default=0.99, ge=0.0, lt=1.0)
     """Discount factor (the paper: 0.99)."""
-    learning_starts: int = 5_000
+    learning_starts: NonNegativeInt = 5_000
     """Transitions collected before the first gradient update."""
-    train_frequency: int = 1
+    train_frequency: PositiveInt = 1
     """Transitions per gradient update (1: one update per transition)."""
-    target_update_interval: int = 1_000
+    target_update_interval: PositiveInt = 1_000
     """Gradient updates between target-network updates."""
-    tau: float = 1.0
+    tau: float = Field(default=1.0, gt=0.0, le=1.0)
     """Target update coefficient: 1.0 copies (hard update), < 1 is Polyak averaging."""
-    eps_start: float = 1.0
+    eps_start: Fraction = 1.0
     """Initial epsilon of the epsilon-greedy exploration."""
-    eps_end: float = 0.05
+    eps_end: Fraction = 0.05
     """Final epsilon."""
-    eps_decay_steps: int = 1_000_000
+    eps_decay_steps: PositiveInt = 1_000_000
     """Transitions over which epsilon decays linearly from ``eps_start`` to ``eps_end``."""
-    eps_final: float | None = None
+    eps_final: Fraction | None = None
     """If set, epsilon drops from ``eps_end`` to this value after ``eps_final_after``."""
-    eps_final_after: int = 0
+    eps_final_after: NonNegativeInt = 0
     """Transitions after which epsilon is ``eps_final``."""
-    n_step: int = 1
+    n_step: PositiveInt = 1
     """Steps summed in each bootstrapped return (1: the paper's one-step target)."""
 
-    traffic_levels: tuple[float, ...] = TRAFFIC_LEVELS
+    traffic_levels: Annotated[tuple[TrafficLevel, ...], FROM_LIST, Field(min_length=1)] = (
+        TRAFFIC_LEVELS
+    )
     """Traffic levels sampled uniformly per episode (1.0 = 900 veh/h on the main road)."""
-    stop_gap_s: tuple[float, float] = (15.0, 60.0)
+    stop_gap_s: Range = (15.0, 60.0)
     """Range [s] of the random time before each injected stop command (even episodes)."""
-    stop_duration_s: tuple[float, float] = (5.0, 15.0)
+    stop_duration_s: Range = (5.0, 15.0)
     """Range [s] of the random duration of each injected stop command."""
-    schedule_horizon_s: float = 900.0
+    schedule_horizon_s: PositiveFloat = 900.0
     """Stop commands are scheduled up to this simulated time [s]."""
-    seed_pool: int | None = None
+    seed_pool: PositiveInt | None = None
     """If set, episode seeds are drawn from this many values (``SEED_POOL_BASE`` onwards), so
     the env's cached warm-up states are reused; ``None`` gives every episode a fresh seed."""
-    rollout_steps: int = 16
+    rollout_steps: PositiveInt = 16
     """Env steps each worker plays per round; the workers get new weights every round."""
-    max_episode_steps: int | None = None
+    max_episode_steps: PositiveInt | None = None
     """Env step limit per episode; ``None`` keeps the env's default."""
     safe_learning: bool = False
     """Learn the shield's rule into the network (``docs/agent.md``): act through the safety
@@ -116,31 +129,51 @@ class TrainConfig:
     actions down to ``unsafe_q``. The mask is never an input of the network."""
     unsafe_q: float = -100.0
     """Value the Q-values of unsafe actions are pushed down to (``safe_learning``)."""
-    unsafe_loss_weight: float = 1.0
+    unsafe_loss_weight: NonNegativeFloat = 1.0
     """Weight of that loss next to the TD loss."""
-    shielded_fraction: float = 1.0
+    shielded_fraction: Fraction = 1.0
     """Share of the episodes (the first ones) that act through the safety mask; the rest act
     on the bare network's choice, still learning from the masks (``safe_learning``)."""
-    stop_when_safe: int | None = None
+    stop_when_safe: PositiveInt | None = None
     """End training once this many consecutive finished episodes had no greedy action the
     shield would override and no violation; ``None`` trains all ``episodes``."""
 
-    checkpoint_every_episodes: int = 100
+    checkpoint_every_episodes: PositiveInt = 100
     """Completed episodes between checkpoints (one is also written at the end)."""
     save_replay: bool = True
     """Checkpoint the replay buffer too, so that ``--resume`` loses only recent transitions."""
-    log_every_updates: int = 250
+    log_every_updates: PositiveInt = 250
     """Gradient updates between TensorBoard loss scalars."""
-    torch_threads: int = 1
+    torch_threads: PositiveInt = 1
     """Threads of the learner process (the env processes use one each)."""
-    moving_average_window: int = 50
+    moving_average_window: PositiveInt = 50
     """Window of the moving average in the training-curve figure (the paper: 50)."""
 
-    def __post_init__(self) -> None:
-        _check_types(self)
-        problems = list(_problems(self))
-        if problems:
-            raise ConfigError("invalid training config: " + "; ".join(problems))
+    @field_validator("mode")
+    @classmethod
+    def _training_mode(cls, mode: str) -> str:
+        if mode not in TRAIN_MODES:
+            raise ValueError(
+                f"must be one of {', '.join(TRAIN_MODES)}, got {mode!r} "
+                "(stop is not a training mode: both agents learn it)"
+            )
+        return mode
+
+    @field_validator("stop_gap_s", "stop_duration_s")
+    @classmethod
+    def _ordered_range(cls, bounds: tuple[float, float]) -> tuple[float, float]:
+        lo, hi = bounds
+        if not 0 < lo <= hi:
+            raise ValueError(f"must be [min, max] with 0 < min <= max, got {[lo, hi]}")
+        return bounds
+
+    @model_validator(mode="after")
+    def _batch_fits_buffer(self) -> TrainConfig:
+        if self.batch_size > self.buffer_size:
+            raise ValueError(
+                f"batch_size ({self.batch_size}) exceeds buffer_size ({self.buffer_size})"
+            )
+        return self
 
     @property
     def envs(self) -> int:
@@ -151,143 +184,6 @@ class TrainConfig:
     def command(self) -> Command:
         """The primary command as a :class:`~explaindrive.commands.Command`."""
         return Command.parse(self.mode)
-
-    def replace(self, **changes: Any) -> TrainConfig:
-        """A copy with some fields changed (validated like :meth:`from_dict`)."""
-        return TrainConfig.from_dict({**self.to_dict(), **changes})
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict (tuples become lists)."""
-        data = dataclasses.asdict(self)
-        return {k: list(v) if isinstance(v, tuple) else v for k, v in data.items()}
-
-    def to_json(self) -> str:
-        """The config as indented JSON."""
-        return json.dumps(self.to_dict(), indent=2, sort_keys=True)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> TrainConfig:
-        """Build a config from a mapping, rejecting unknown keys and coercing lists.
-
-        Raises:
-            ConfigError: on an unknown key or an invalid value.
-        """
-        if not isinstance(data, Mapping):
-            raise ConfigError(f"a training config must be a mapping, got {type(data).__name__}")
-        names = {f.name for f in dataclasses.fields(cls)}
-        unknown = sorted(set(data) - names)
-        if unknown:
-            raise ConfigError(
-                f"unknown config key(s): {', '.join(unknown)}; "
-                f"known keys: {', '.join(sorted(names))}"
-            )
-        hints = typing.get_type_hints(cls)
-        values = {k: _coerce(k, v, hints[k]) for k, v in data.items()}
-        return cls(**values)
-
-
-def _problems(c: TrainConfig) -> typing.Iterator[str]:
-    if c.mode not in TRAIN_MODES:
-        yield (
-            f"mode must be one of {', '.join(TRAIN_MODES)}, got {c.mode!r} "
-            "(stop is not a training mode: both agents learn it)"
-        )
-    if c.loss not in LOSSES:
-        yield f"loss must be one of {', '.join(LOSSES)}, got {c.loss!r}"
-    positive = (
-        "episodes", "lr_decay_steps", "buffer_size", "batch_size", "train_frequency",
-        "target_update_interval", "eps_decay_steps", "checkpoint_every_episodes",
-        "log_every_updates", "torch_threads", "moving_average_window", "n_step", "rollout_steps",
-    )  # fmt: skip
-    for name in positive:
-        if getattr(c, name) <= 0:
-            yield f"{name} must be > 0, got {getattr(c, name)}"
-    for name in ("num_envs", "max_episode_steps", "seed_pool", "stop_when_safe"):
-        value = getattr(c, name)
-        if value is not None and value <= 0:
-            yield f"{name} must be > 0 or null, got {value}"
-    if not c.hidden_sizes or any(h <= 0 for h in c.hidden_sizes):
-        yield f"hidden_sizes must be a non-empty list of positive ints, got {c.hidden_sizes}"
-    for name in ("lr", "huber_delta", "schedule_horizon_s"):
-        if getattr(c, name) <= 0:
-            yield f"{name} must be > 0, got {getattr(c, name)}"
-    for name in ("lr_final", "grad_clip_norm"):
-        value = getattr(c, name)
-        if value is not None and value <= 0:
-            yield f"{name} must be > 0 or null, got {value}"
-    if not 0.0 <= c.gamma < 1.0:
-        yield f"gamma must be in [0, 1), got {c.gamma}"
-    if not 0.0 < c.tau <= 1.0:
-        yield f"tau must be in (0, 1], got {c.tau}"
-    for name in ("eps_start", "eps_end", "eps_final", "shielded_fraction"):
-        value = getattr(c, name)
-        if value is not None and not 0.0 <= value <= 1.0:
-            yield f"{name} must be in [0, 1], got {value}"
-    if c.eps_final_after < 0:
-        yield f"eps_final_after must be >= 0, got {c.eps_final_after}"
-    if c.unsafe_loss_weight < 0:
-        yield f"unsafe_loss_weight must be >= 0, got {c.unsafe_loss_weight}"
-    if c.learning_starts < 0:
-        yield f"learning_starts must be >= 0, got {c.learning_starts}"
-    if c.batch_size > c.buffer_size:
-        yield f"batch_size ({c.batch_size}) exceeds buffer_size ({c.buffer_size})"
-    if not c.traffic_levels:
-        yield "traffic_levels must be a non-empty list"
-    for level in c.traffic_levels:
-        try:
-            validate_traffic_level(level)
-        except ValueError as exc:
-            yield f"traffic_levels: {exc}"
-    for name in ("stop_gap_s", "stop_duration_s"):
-        lo, hi = getattr(c, name)
-        if not 0 < lo <= hi:
-            yield f"{name} must be [min, max] with 0 < min <= max, got {[lo, hi]}"
-
-
-def _check_types(c: TrainConfig) -> None:
-    hints = typing.get_type_hints(type(c))
-    for f in dataclasses.fields(c):
-        _coerce(f.name, getattr(c, f.name), hints[f.name])
-
-
-def _coerce(name: str, value: Any, hint: Any) -> Any:
-    """Check ``value`` against ``hint`` (and turn lists into tuples, ints into floats)."""
-    origin = typing.get_origin(hint)
-    args = typing.get_args(hint)
-    if origin in (types.UnionType, typing.Union):
-        if value is None and type(None) in args:
-            return None
-        inner = [a for a in args if a is not type(None)]
-        return _coerce(name, value, inner[0])
-    if origin is tuple:
-        if not isinstance(value, list | tuple):
-            raise ConfigError(f"config key {name!r} must be a list, got {value!r}")
-        if len(args) == 2 and args[1] is Ellipsis:
-            items = [_coerce(name, v, args[0]) for v in value]
-        else:
-            if len(value) != len(args):
-                raise ConfigError(f"config key {name!r} must have {len(args)} items, got {value!r}")
-            items = [_coerce(name, v, a) for v, a in zip(value, args, strict=True)]
-        return tuple(items)
-    if hint is bool:
-        if not isinstance(value, bool):
-            raise ConfigError(f"config key {name!r} must be true/false, got {value!r}")
-        return value
-    if hint is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"config key {name!r} must be an integer, got {value!r}")
-        return value
-    if hint is float:
-        if isinstance(value, str) and _NUMBER.fullmatch(value.strip()):
-            value = float(value)  # YAML 1.1 reads "1e-3" (no dot) as a string
-        if isinstance(value, bool) or not isinstance(value, int | float) or value != value:
-            raise ConfigError(f"config key {name!r} must be a number, got {value!r}")
-        return float(value)
-    if hint is str:
-        if not isinstance(value, str):
-            raise ConfigError(f"config key {name!r} must be a string, got {value!r}")
-        return value
-    return value
 
 
 PAPER = TrainConfig()
@@ -353,7 +249,7 @@ def load_config_file(path: str | Path) -> dict[str, Any]:
     except OSError as exc:
         raise ConfigError(f"cannot read config file {path}: {exc}") from exc
     try:
-        data = json.loads(text) if path.suffix == ".json" else yaml.safe_load(text)
+        data = json.loads(text) if path.suffix == ".json" else read_yaml(text)
     except (json.JSONDecodeError, yaml.YAMLError) as exc:
         raise ConfigError(f"cannot parse config file {path}: {exc}") from exc
     if data is None:
@@ -364,7 +260,7 @@ def load_config_file(path: str | Path) -> dict[str, Any]:
 
 
 def parse_override(item: str) -> tuple[str, Any]:
-    """Parse one ``key=value`` override; the value is read as YAML (``1e-4``, ``[64, 64]``).
+    """Parse one ``key=value`` override; the value is read as YAML (``3e-4``, ``[64, 64]``).
 
     Raises:
         ConfigError: if ``item`` has no ``=``.
@@ -373,7 +269,7 @@ def parse_override(item: str) -> tuple[str, Any]:
     if not sep or not key.strip():
         raise ConfigError(f"override {item!r} must look like key=value")
     try:
-        value = yaml.safe_load(raw)
+        value = read_yaml(raw)
     except yaml.YAMLError as exc:
         raise ConfigError(f"cannot parse the value of override {item!r}: {exc}") from exc
     return key.strip(), value

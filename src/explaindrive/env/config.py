@@ -2,19 +2,17 @@
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Mapping
-from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
-from explaindrive.sim.scenario.layout import validate_traffic_level
+from pydantic import NonNegativeInt, PositiveInt
+
+from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
 
-@dataclass(frozen=True, slots=True)
-class EnvConfig:
+class EnvConfig(ConfigModel):
     """Settings of :class:`~explaindrive.env.urban_drive.UrbanDriveEnv`.
 
     Attributes:
@@ -31,45 +29,22 @@ class EnvConfig:
             a standstill (at most 3 m/s^2) and hold it.
     """
 
-    traffic_level: float = 1.0
-    max_steps: int = 1000
-    warmup_s: int = 180
-    normalize_obs: bool = False
-    net_file: Path | None = None
-    cache_dir: Path | None = None
-    insert_timeout_s: int = 60
-    ego_model: str = "agent"
+    config_name = "env config"
 
-    def __post_init__(self) -> None:
-        validate_traffic_level(self.traffic_level)
-        for name in ("max_steps", "insert_timeout_s"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
-                raise ValueError(f"{name} must be a positive integer, got {value!r}")
-        if (
-            isinstance(self.warmup_s, bool)
-            or not isinstance(self.warmup_s, int)
-            or self.warmup_s < 0
-        ):
-            raise ValueError(f"warmup_s must be an integer >= 0, got {self.warmup_s!r}")
-        if self.ego_model not in EGO_MODELS:
-            raise ValueError(f"ego_model must be one of {EGO_MODELS}, got {self.ego_model!r}")
-        for name in ("net_file", "cache_dir"):
-            value = getattr(self, name)
-            if value is not None and not isinstance(value, Path):
-                object.__setattr__(self, name, Path(value))
+    traffic_level: TrafficLevel = 1.0
+    max_steps: PositiveInt = 1000
+    warmup_s: NonNegativeInt = 180
+    normalize_obs: bool = False
+    net_file: TextPath | None = None
+    cache_dir: TextPath | None = None
+    insert_timeout_s: PositiveInt = 60
+    ego_model: Annotated[str, one_of(EGO_MODELS)] = "agent"
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any]) -> EnvConfig:
-        """Build a config from a mapping, rejecting unknown keys.
+        """Build a config from a mapping, rejecting unknown keys (as :meth:`from_dict`).
 
         Raises:
-            ValueError: on unknown keys or invalid values.
+            ConfigError: naming every unknown key and every invalid value.
         """
-        known = {f.name for f in dataclasses.fields(cls)}
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise ValueError(
-                f"unknown env config key(s): {', '.join(unknown)}; known: {sorted(known)}"
-            )
-        return cls(**dict(data))
+        return cls.from_dict(data)

@@ -7,7 +7,6 @@ pedestrian-yield and speed-limit violations can happen and are counted.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import math
 import os
@@ -145,11 +144,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         if render_mode not in (None, "human"):
             raise ValueError(f"render_mode must be None or 'human', got {render_mode!r}")
         if isinstance(config, EnvConfig):
-            cfg = (
-                EnvConfig.from_mapping({**dataclasses.asdict(config), **overrides})
-                if overrides
-                else config
-            )
+            cfg = config.replace(**overrides) if overrides else config
         else:
             cfg = EnvConfig.from_mapping({**dict(config or {}), **overrides})
         self.config = cfg

@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from typing import Annotated
 
+from pydantic import AfterValidator, NonNegativeFloat, PositiveInt
+
+from explaindrive.config import ConfigModel, Seed, TrafficLevel
 from explaindrive.language.backends import check_backend
-from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
 
 
-@dataclass(frozen=True, slots=True)
-class RideConfig:
+class RideConfig(ConfigModel):
     """Settings of :class:`~explaindrive.ride.session.RideSession`.
 
     Attributes:
@@ -30,31 +30,17 @@ class RideConfig:
         gui: show the ride in sumo-gui.
     """
 
-    traffic_level: float = 1.0
-    seed: int = 0
-    max_steps: int = 600
-    backend: str = "embedded"
+    config_name = "ride config"
+
+    traffic_level: TrafficLevel = 1.0
+    seed: Seed = 0
+    max_steps: PositiveInt = 600
+    backend: Annotated[str, AfterValidator(check_backend)] = "embedded"
     auto_confirm: bool = False
     stop_without_confirm: bool = False
-    explanation_cooldown_s: float = 15.0
-    interpret_deadline_s: float = 2.0
-    audio_deadline_s: float = 8.0
-    explain_deadline_s: float = 1.0
+    explanation_cooldown_s: NonNegativeFloat = 15.0
+    interpret_deadline_s: NonNegativeFloat = 2.0
+    audio_deadline_s: NonNegativeFloat = 8.0
+    explain_deadline_s: NonNegativeFloat = 1.0
     realtime: bool = False
     gui: bool = False
-
-    def __post_init__(self) -> None:
-        validate_traffic_level(self.traffic_level)
-        validate_seed(self.seed)
-        if self.max_steps <= 0:
-            raise ValueError(f"max_steps must be > 0, got {self.max_steps}")
-        for name in (
-            "explanation_cooldown_s",
-            "interpret_deadline_s",
-            "audio_deadline_s",
-            "explain_deadline_s",
-        ):
-            value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value}")
-        check_backend(self.backend)
