@@ -17,7 +17,7 @@ import threading
 from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType
-from typing import TYPE_CHECKING, NoReturn
+from typing import TYPE_CHECKING, Annotated, NoReturn
 
 import typer
 from rich.console import Console
@@ -46,33 +46,55 @@ console = Console()
 EXIT_INTERRUPTED = 130  # the shell's status for a command ended by Ctrl+C
 
 
+ScriptOption = Annotated[
+    Path | None, typer.Option("--script", help="Timed passenger lines (YAML/JSON).")
+]
+InteractiveOption = Annotated[
+    bool, typer.Option("--interactive", help="Type requests during the ride.")
+]
+VoiceOption = Annotated[
+    bool, typer.Option("--voice", help="With --interactive: speak from the microphone.")
+]
+BackendOption = Annotated[
+    str, typer.Option("--backend", help="Language backend: embedded or openai.")
+]
+EncoderOption = Annotated[str, typer.Option("--encoder", help=ENCODER_HELP)]
+TrafficOption = Annotated[float, typer.Option("--traffic", help="Traffic level (1.0 = 900 veh/h).")]
+SeedOption = Annotated[int, typer.Option("--seed", help="Simulation seed.")]
+GuiOption = Annotated[bool, typer.Option("--gui", help="Show the ride in sumo-gui.")]
+RealtimeOption = Annotated[bool, typer.Option("--realtime", help="One step per second.")]
+OutOption = Annotated[Path, typer.Option("--out", help="Output directory (empty or new).")]
+ForceOption = Annotated[
+    bool, typer.Option("--force", help="Replace the ride already in --out instead of refusing.")
+]
+AutoConfirmOption = Annotated[
+    bool, typer.Option("--auto-confirm", help="Answer every question with yes.")
+]
+StopWithoutConfirmOption = Annotated[
+    bool, typer.Option("--stop-without-confirm", help="Apply STOP requests without asking.")
+]
+MaxStepsOption = Annotated[int, typer.Option("--max-steps", help="Longest ride [s].")]
+CooldownOption = Annotated[float, typer.Option("--cooldown", help="Explanation cool-down [s].")]
+LiveOption = Annotated[bool, typer.Option("--live/--no-live", help="Live terminal view.")]
+
+
 def ride(
-    script: Path = typer.Option(None, "--script", help="Timed passenger lines (YAML/JSON)."),
-    interactive: bool = typer.Option(False, "--interactive", help="Type requests during the ride."),
-    voice: bool = typer.Option(
-        False, "--voice", help="With --interactive: speak from the microphone."
-    ),
-    backend: str = typer.Option(
-        "embedded", "--backend", help="Language backend: embedded or openai."
-    ),
-    encoder: str = typer.Option(DEFAULT_ENCODER, "--encoder", help=ENCODER_HELP),
-    traffic: float = typer.Option(1.0, "--traffic", help="Traffic level (1.0 = 900 veh/h)."),
-    seed: int = typer.Option(0, "--seed", help="Simulation seed."),
-    gui: bool = typer.Option(False, "--gui", help="Show the ride in sumo-gui."),
-    realtime: bool = typer.Option(False, "--realtime", help="One step per second."),
-    out: Path = typer.Option(Path("out/ride"), "--out", help="Output directory (empty or new)."),
-    force: bool = typer.Option(
-        False, "--force", help="Replace the ride already in --out instead of refusing."
-    ),
-    auto_confirm: bool = typer.Option(
-        False, "--auto-confirm", help="Answer every question with yes."
-    ),
-    stop_without_confirm: bool = typer.Option(
-        False, "--stop-without-confirm", help="Apply STOP requests without asking."
-    ),
-    max_steps: int = typer.Option(600, "--max-steps", help="Longest ride [s]."),
-    cooldown: float = typer.Option(15.0, "--cooldown", help="Explanation cool-down [s]."),
-    live: bool = typer.Option(True, "--live/--no-live", help="Live terminal view."),
+    script: ScriptOption = None,
+    interactive: InteractiveOption = False,
+    voice: VoiceOption = False,
+    backend: BackendOption = "embedded",
+    encoder: EncoderOption = DEFAULT_ENCODER,
+    traffic: TrafficOption = 1.0,
+    seed: SeedOption = 0,
+    gui: GuiOption = False,
+    realtime: RealtimeOption = False,
+    out: OutOption = Path("out/ride"),
+    force: ForceOption = False,
+    auto_confirm: AutoConfirmOption = False,
+    stop_without_confirm: StopWithoutConfirmOption = False,
+    max_steps: MaxStepsOption = 600,
+    cooldown: CooldownOption = 15.0,
+    live: LiveOption = True,
 ) -> None:
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     if voice and not interactive:
@@ -90,31 +112,41 @@ def ride(
             gui=gui,
         )
         language_config = LanguageConfig().with_encoder(encoder)
-        lines = (
-            []
-            if interactive and script is None
-            else load_script(script or default_script_path(), max_time_s=float(max_steps))
-        )
+        lines = _script_lines(script, interactive, max_steps)
         prepare_out_dir(out, force)
     except (ValueError, ScriptError, OutputDirError) as exc:
         _refuse(exc)
     session = _build_session(config, language_config, lines, speech=voice)
-    typed: queue.Queue[str] | None = None
-    if interactive:
-        typed = queue.Queue()
-        _start_input_thread(typed, voice)
+    typed = _passenger_input(voice) if interactive else None
     if script is None and not interactive:
         console.print(f"default ride script: {default_script_path()}")
     outputs = _run(session, lines, out, typed, live)
     _print_summary(session, outputs)
     if outputs.interrupted is not None:
-        console.print(
-            f"the ride was {outputs.interrupted} after {len(session.records)} s; "
-            f"{outputs.summary} marks it interrupted",
-            soft_wrap=True,
-            highlight=False,
-        )
-        raise typer.Exit(EXIT_INTERRUPTED)
+        _exit_interrupted(session, outputs)
+
+
+def _script_lines(script: Path | None, interactive: bool, max_steps: int) -> list[ScriptLine]:
+    """The timed passenger lines: ``script``, none for an interactive ride without one, else
+    the default script.
+
+    Raises:
+        ScriptError: if the script cannot be read or holds a bad line.
+    """
+    if interactive and script is None:
+        return []
+    return load_script(script or default_script_path(), max_time_s=float(max_steps))
+
+
+def _exit_interrupted(session: RideSession, outputs: RideOutputs) -> NoReturn:
+    """Say how the ride was interrupted and exit with status 130."""
+    console.print(
+        f"the ride was {outputs.interrupted} after {len(session.records)} s; "
+        f"{outputs.summary} marks it interrupted",
+        soft_wrap=True,
+        highlight=False,
+    )
+    raise typer.Exit(EXIT_INTERRUPTED)
 
 
 def _refuse(message: object) -> NoReturn:
@@ -200,7 +232,11 @@ def _stop_on_signals(stop: threading.Event) -> Iterator[None]:
             signal.signal(sig, old)
 
 
-def _start_input_thread(typed: queue.Queue[str], voice: bool) -> None:
+def _passenger_input(voice: bool) -> queue.Queue[str]:
+    """Start reading the passenger's typed (or, with ``voice``, spoken) requests in the
+    background; returns the queue they arrive in."""
+    typed: queue.Queue[str] = queue.Queue()
+
     def read() -> None:
         from explaindrive.ride.microphone import MicrophoneUnavailableError, record
 
@@ -221,6 +257,7 @@ def _start_input_thread(typed: queue.Queue[str], voice: bool) -> None:
     else:
         console.print("type a request (or yes/no to answer a question) and press Enter")
     threading.Thread(target=read, daemon=True, name="passenger-input").start()
+    return typed
 
 
 def _print_summary(session: RideSession, outputs: RideOutputs) -> None:
