@@ -6,8 +6,9 @@ from pathlib import Path
 from typing import Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
 
+from explaindrive.config import StrictModel
 from explaindrive.language.encoders import (
     DEFAULT_ENCODER,
     DEFAULT_RUNTIME,
@@ -22,8 +23,9 @@ BackendName = Literal["embedded", "openai"]
 SUMMARY_CUTOFF_M = 50.0  # [m] objects farther than this are left out of summaries and decisions
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+class _Strict(StrictModel):
+    # YAML gives paths as text and 3e-4 as a string: lax types, the other rules are shared
+    model_config = ConfigDict(strict=False)
 
 
 class SpeechConfig(_Strict):
