@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_language.py [--backend embedded|openai] [--n 200]
-        [--encoder minilm|mpnet] [--runtime onnx|torch]
+        [--runtime onnx|torch]
 
 Prints p50/p95 latencies [ms] after model load and Whisper tiny.en's real-time factor
 on espeak-ng speech (skipped when espeak-ng is missing). Targets on 2 cores: embedded
@@ -31,13 +31,7 @@ from explaindrive.language.datasets import (
     load_commands,
     load_decisions,
 )
-from explaindrive.language.encoders import (
-    DEFAULT_ENCODER,
-    DEFAULT_RUNTIME,
-    ENCODERS,
-    RUNTIMES,
-    encoder_threads,
-)
+from explaindrive.language.encoders import DEFAULT_RUNTIME, RUNTIMES, encoder_threads
 from explaindrive.language.stack import make_language_stack
 
 SENTENCES = (
@@ -58,14 +52,11 @@ def main() -> None:
     parser.add_argument("--backend", default="embedded", choices=("embedded", "openai"))
     parser.add_argument("--n", type=int, default=200, help="requests / records timed")
     parser.add_argument(
-        "--encoder", default=DEFAULT_ENCODER, choices=ENCODERS, help="LLM-1 encoder"
-    )
-    parser.add_argument(
         "--runtime", default=DEFAULT_RUNTIME, choices=RUNTIMES, help="LLM-1 encoder runtime"
     )
     args = parser.parse_args()
     console = Console()
-    config = LanguageConfig().with_encoder(args.encoder, args.runtime)
+    config = LanguageConfig().with_runtime(args.runtime)
     stack = make_language_stack(args.backend, config)
     t0 = time.perf_counter()
     stack.interpreter.interpret("warm up")  # loads the encoder
@@ -90,7 +81,7 @@ def main() -> None:
 
     threads = encoder_threads(args.runtime, config.embedded.encoder_threads)
     table = Table(
-        title=f"language layer, backend {args.backend}, encoder {args.encoder} on "
+        title=f"language layer, backend {args.backend}, all-MiniLM-L6-v2 on "
         f"{args.runtime}, {threads} threads (load {load_s:.1f} s)"
     )
     for col in ("call", "n", "p50 [ms]", "p95 [ms]"):

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python scripts/compare_encoder_runtimes.py [--encoder minilm|mpnet]
+    python scripts/compare_encoder_runtimes.py
 
 Encodes every request of the development and test splits with both runtimes and prints
 the largest embedding difference, the lowest cosine, whether the token ids agree, and how
@@ -16,19 +16,16 @@ import argparse
 import numpy as np
 
 from explaindrive.language.datasets import DEV_SPLITS, TEST_SPLITS, data_path, load_commands
-from explaindrive.language.encoders import DEFAULT_ENCODER, ENCODERS
 from explaindrive.language.features import SentenceEncoder, features_from_embeddings, normalize_text
 from explaindrive.language.intent_classifier import IntentClassifier, decide_rows
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--encoder", default=DEFAULT_ENCODER, choices=ENCODERS)
-    args = parser.parse_args()
+    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()
     texts = [r.text for name in (*DEV_SPLITS, *TEST_SPLITS) for r in load_commands(data_path(name))]
     normalized = [normalize_text(t) for t in texts]
-    onnx = SentenceEncoder(name=args.encoder, runtime="onnx")
-    torch = SentenceEncoder(name=args.encoder, runtime="torch")
+    onnx = SentenceEncoder(runtime="onnx")
+    torch = SentenceEncoder(runtime="torch")
     a, b = onnx.encode(normalized), torch.encode(normalized)
     runner = onnx._onnx
     torch.load()
@@ -37,7 +34,7 @@ def main() -> None:
         runner.tokens([t])["input_ids"][0].tolist() == prepare([t])["input_ids"][0].tolist()
         for t in normalized
     )
-    clf = IntentClassifier.load(None, args.encoder)
+    clf = IntentClassifier.load()
     decide = [
         decide_rows(
             clf.proba(features_from_embeddings(e, texts, clf.spec)),
@@ -48,8 +45,7 @@ def main() -> None:
     ]
     differ = int(np.sum(decide[0] != decide[1]))
     print(
-        f"encoder {args.encoder}: {len(texts)} requests of {len(DEV_SPLITS)} development "
-        f"and {len(TEST_SPLITS)} test splits"
+        f"{len(texts)} requests of {len(DEV_SPLITS)} development and {len(TEST_SPLITS)} test splits"
     )
     print(f"max |onnx - torch| per component: {float(np.max(np.abs(a - b))):.2e}")
     print(f"lowest cosine: {float(np.min(np.sum(a * b, axis=1))):.7f}")

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python scripts/decision_tradeoffs.py [--encoder minilm|mpnet] [--runtime torch|onnx]
+    python scripts/decision_tradeoffs.py [--runtime torch|onnx]
 
 Rebuilds the held-out probabilities the shipped model's settings were tuned on (each
 development split predicted by a model fitted on the training requests and the other
@@ -23,7 +23,7 @@ from rich.console import Console
 from rich.table import Table
 
 from explaindrive.language.datasets import DEV_SPLITS, TRAIN_CSV, data_path, load_commands
-from explaindrive.language.encoders import DEFAULT_ENCODER, ENCODERS, RUNTIMES
+from explaindrive.language.encoders import RUNTIMES
 from explaindrive.language.features import SentenceEncoder
 from explaindrive.language.intent_classifier import (
     BUILD_RUNTIME,
@@ -39,15 +39,14 @@ from explaindrive.language.intent_classifier import (
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--encoder", default=DEFAULT_ENCODER, choices=ENCODERS)
     parser.add_argument("--runtime", default=BUILD_RUNTIME, choices=RUNTIMES)
     args = parser.parse_args()
-    shipped = IntentClassifier.load(None, args.encoder)
+    shipped = IntentClassifier.load()
     spec = shipped.spec
     hyper = Hyper(
         ngram_weight=spec.ngram_weight, cue_weight=spec.cue_weight, lr_weight=shipped.lr_weight
     )
-    encoder = SentenceEncoder(name=args.encoder, runtime=args.runtime)
+    encoder = SentenceEncoder(runtime=args.runtime)
     train = Encoded.of(load_commands(data_path(TRAIN_CSV)), encoder)
     devs = [Encoded.of(load_commands(data_path(name)), encoder) for name in DEV_SPLITS]
     p = held_out_proba(train, devs, spec, hyper.c, hyper)
@@ -55,7 +54,7 @@ def main() -> None:
     commands = y != NONE
     console = Console()
     console.print(
-        f"{args.encoder}: {len(y)} held-out development requests ({int(commands.sum())} "
+        f"{len(y)} held-out development requests ({int(commands.sum())} "
         f"commands, {int((y == STOP).sum())} STOP); shipped STOP threshold "
         f"{shipped.stop_threshold:.2f}, none margin {shipped.none_margin:.2f}"
     )

@@ -12,7 +12,7 @@ import pytest
 
 from explaindrive.env.urban_drive import UrbanDriveEnv
 
-MODEL_FIXTURES = frozenset({"interpreter", "mpnet", "transcriber", "speak"})
+MODEL_FIXTURES = frozenset({"interpreter", "transcriber", "speak"})
 MODEL_MODULES = frozenset({
     "tests/ride/test_ride_shipped.py", "tests/ride/test_stop_lane.py",
     "tests/language/test_cli.py", "tests/language/test_shipped_models.py",
@@ -57,32 +57,3 @@ def make_env() -> Iterator[Callable[..., UrbanDriveEnv]]:
     yield factory
     for env in made:
         env.close()
-
-
-@pytest.fixture
-def without_mpnet(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """As if the optional ``mpnet`` extra were not installed and mpnet never extracted."""
-    from importlib import metadata
-
-    from explaindrive.language import encoders
-
-    def missing(name: str) -> metadata.Distribution:
-        raise metadata.PackageNotFoundError(name)
-
-    monkeypatch.setattr(encoders.metadata, "distribution", missing)
-    monkeypatch.setenv("EXPLAINDRIVE_CACHE", str(tmp_path))
-
-
-def mpnet_installed() -> bool:
-    """Whether the optional ``mpnet`` extra (all-mpnet-base-v2) is installed."""
-    from explaindrive.language.encoders import mpnet_part_files
-
-    try:
-        mpnet_part_files()
-    except FileNotFoundError:
-        return False
-    return True
-
-
-MPNET_MISSING = "the optional mpnet extra is not installed (pip install -e '.[mpnet]')"
-needs_mpnet = pytest.mark.skipif(not mpnet_installed(), reason=MPNET_MISSING)

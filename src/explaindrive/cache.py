@@ -1,8 +1,8 @@
 """The per-user cache: the one place that says where derived files live and how a folder
 is put there whole.
 
-Generated demand files, warm-up states, the extracted mpnet model and the ONNX exports of
-the sentence encoders all live under :func:`cache_dir`. A folder is built in a temporary
+Generated demand files, warm-up states and the ONNX export of the sentence encoder all live
+under :func:`cache_dir`. A folder is built in a temporary
 folder next to its target and :func:`publish` renames it into place with a completion
 mark, so a killed run never leaves a half-written folder that looks finished.
 """

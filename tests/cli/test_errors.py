@@ -9,7 +9,7 @@ from explaindrive.cli._errors import error_line
 
 def test_brackets_in_a_message_are_printed_not_read_as_markup() -> None:
     console = Console(record=True, width=200, color_system=None)
-    message = "install it with `pip install -e '.[mpnet]'`; Input should be 1 [type=int_type]"
+    message = "install it with `pip install 'explaindrive[ray]'`; Input should be 1 [type=int_type]"
     console.print(error_line(message))
     assert console.export_text() == f"error: {message}\n"
     console.print(error_line(ValueError("[bold]not a style[/bold]")))

@@ -14,10 +14,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from tests.conftest import MPNET_MISSING, mpnet_installed
 
 from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
-from explaindrive.language.config import EmbeddedConfig
 from explaindrive.language.speech import Transcriber
 
 
@@ -25,17 +23,6 @@ from explaindrive.language.speech import Transcriber
 def interpreter() -> EmbeddedIntentInterpreter:
     """The default embedded LLM-1 (MiniLM), its encoder loaded once for the whole session."""
     it = EmbeddedIntentInterpreter()
-    it.load()
-    return it
-
-
-@pytest.fixture(scope="session")
-def mpnet() -> EmbeddedIntentInterpreter:
-    """The embedded LLM-1 over all-mpnet-base-v2, loaded once for the whole session (the
-    tests that use it are skipped without the optional mpnet extra)."""
-    if not mpnet_installed():
-        pytest.skip(MPNET_MISSING)
-    it = EmbeddedIntentInterpreter(EmbeddedConfig(encoder="mpnet"))
     it.load()
     return it
 

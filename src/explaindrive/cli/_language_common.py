@@ -17,15 +17,13 @@ err_console = Console(stderr=True)
 
 BACKEND_HELP = "Language backend: embedded (offline, default) or openai."
 CONFIG_HELP = "YAML language config (see docs/language.md)."
-ENCODER_HELP = "LLM-1 sentence encoder of the embedded backend: minilm (default) or mpnet."
+ENCODER_HELP = "LLM-1 sentence encoder of the embedded backend: minilm (the only one)."
 
 
-def load_config(path: Path | None, encoder: str | None = None) -> LanguageConfig:
-    """The language config from ``path`` or the defaults, with ``encoder`` (if given)
-    replacing ``embedded.encoder``; exits with a message on errors."""
+def load_config(path: Path | None) -> LanguageConfig:
+    """The language config from ``path`` or the defaults; exits with a message on errors."""
     try:
-        config = LanguageConfig() if path is None else LanguageConfig.from_yaml(path)
-        return config if encoder is None else config.with_encoder(encoder)
+        return LanguageConfig() if path is None else LanguageConfig.from_yaml(path)
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
 

@@ -12,7 +12,6 @@ from rich.table import Table
 from explaindrive.cli._language_common import (
     BACKEND_HELP,
     CONFIG_HELP,
-    ENCODER_HELP,
     console,
     fail,
     load_config,
@@ -42,22 +41,20 @@ def intents_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
-    encoder: Annotated[str | None, typer.Option("--encoder", help=ENCODER_HELP)] = None,
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
     try:
         rows = load_commands(data)
         from explaindrive.language.stack import make_language_stack
 
-        cfg = load_config(config, encoder)
-        stack = make_language_stack(backend, cfg).load()
+        stack = make_language_stack(backend, load_config(config)).load()
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_intents
 
     report = evaluate_intents(stack.interpreter, rows)
-    report.update(backend=stack.backend, encoder=cfg.embedded.encoder, data=str(data))
-    table = Table(title=f"LLM-1 on {data.name} ({stack.backend}, {cfg.embedded.encoder})")
+    report.update(backend=stack.backend, data=str(data))
+    table = Table(title=f"LLM-1 on {data.name} ({stack.backend})")
     for col in ("class", "precision", "recall", "F1", "support"):
         table.add_column(col, justify="right")
     for name, m in report["per_class"].items():

@@ -10,7 +10,6 @@ import typer
 from explaindrive.cli._language_common import (
     BACKEND_HELP,
     CONFIG_HELP,
-    ENCODER_HELP,
     console,
     emit_json,
     fail,
@@ -25,7 +24,6 @@ def interpret_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
-    encoder: Annotated[str | None, typer.Option("--encoder", help=ENCODER_HELP)] = None,
 ) -> None:
     """Map a passenger request (text or --audio) to fast, comfort, stop or no command."""
     if (text is None) == (audio is None):
@@ -33,7 +31,7 @@ def interpret_command(
     try:
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config, encoder)).load()
+        stack = make_language_stack(backend, load_config(config)).load()
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     transcript = None

@@ -10,9 +10,7 @@ from pydantic import ConfigDict, Field
 
 from explaindrive.config import StrictModel
 from explaindrive.language.encoders import (
-    DEFAULT_ENCODER,
     DEFAULT_RUNTIME,
-    EncoderName,
     EncoderRuntime,
     check_encoder,
     check_runtime,
@@ -48,15 +46,10 @@ class SpeechConfig(_Strict):
 class EmbeddedConfig(_Strict):
     """Offline backend: sentence embeddings + shipped classifier, rule engine, templates."""
 
-    encoder: EncoderName = DEFAULT_ENCODER
-    """Sentence encoder of LLM-1: ``minilm`` (all-MiniLM-L6-v2, default) or ``mpnet``
-    (all-mpnet-base-v2: about four times slower, fewer held-out errors; see
-    docs/language.md)."""
     embedding_model_dir: Path | None = None
-    """sentence-transformers model directory; ``None`` = the encoder's packaged model."""
+    """sentence-transformers model directory; ``None`` = all-MiniLM-L6-v2 as packaged."""
     classifier_path: Path | None = None
-    """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data`` for
-    ``encoder``."""
+    """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data``."""
     stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
     """STOP wins whenever its probability reaches this; ``None`` = the value stored with the
     weights (tuned on the held-out development splits)."""
@@ -100,17 +93,24 @@ class LanguageConfig(_Strict):
     embedded: EmbeddedConfig = EmbeddedConfig()
     openai: OpenAIConfig = OpenAIConfig()
 
-    def with_encoder(self, encoder: str, runtime: str | None = None) -> LanguageConfig:
-        """This config with ``embedded.encoder`` (and ``encoder_runtime``, if given) replaced.
+    def with_runtime(self, runtime: str) -> LanguageConfig:
+        """This config with ``embedded.encoder_runtime`` replaced.
 
         Raises:
-            ValueError: for an unknown encoder name or runtime.
+            ValueError: for an unknown runtime.
         """
-        update: dict[str, str] = {"encoder": check_encoder(encoder)}
-        if runtime is not None:
-            update["encoder_runtime"] = check_runtime(runtime)
-        embedded = self.embedded.model_copy(update=update)
+        embedded = self.embedded.model_copy(update={"encoder_runtime": check_runtime(runtime)})
         return self.model_copy(update={"embedded": embedded})
+
+    def with_encoder(self, encoder: str) -> LanguageConfig:
+        """This config, once ``encoder`` is checked to name the one sentence encoder (the
+        ``--encoder`` option of ``explaindrive ride``).
+
+        Raises:
+            ValueError: for any name but ``minilm``.
+        """
+        check_encoder(encoder)
+        return self
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> LanguageConfig:

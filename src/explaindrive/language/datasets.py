@@ -50,7 +50,7 @@ DEV9_CSV = "commands_dev9.csv"
 DEV10_CSV = "commands_dev10.csv"
 """Tenth development split (the round-10 test split, evaluated by the round-10 model)."""
 DEV11_CSV = "commands_dev11.csv"
-"""The round-11 test split, evaluated once by the round-11 MiniLM and mpnet models."""
+"""The round-11 test split, evaluated once by the round-11 models."""
 DEV12_CSV = "commands_dev12.csv"
 """The round-12 test split, evaluated once by the round-11 models and a withdrawn cascade."""
 DEV13_CSV = "commands_dev13.csv"
@@ -85,11 +85,6 @@ TEST_SPLITS: tuple[str, ...] = (TEST10_CSV, TEST_CSV)
 DECISIONS_JSONL = "decisions.jsonl"
 CLASSIFIER_NPZ = "intent_classifier.npz"
 """The shipped LLM-1 weights over all-MiniLM-L6-v2."""
-CLASSIFIER_FILES: dict[str, str] = {
-    "minilm": CLASSIFIER_NPZ,
-    "mpnet": "intent_classifier_mpnet.npz",
-}
-"""The shipped LLM-1 weights per sentence encoder."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,4 +1,4 @@
-"""Sentence features for the embedded LLM-1: sentence embeddings (MiniLM by default, see
+"""Sentence features for the embedded LLM-1: sentence embeddings (all-MiniLM-L6-v2, see
 :mod:`explaindrive.language.encoders`), hashed word n-grams and lexical direction cues.
 
 The embedding carries meaning ("I'm late" ~ faster); the hashed n-grams carry short
@@ -24,14 +24,12 @@ from sklearn.feature_extraction.text import HashingVectorizer
 from explaindrive.cache import cache_dir
 from explaindrive.language.cues import N_CUES, cue_features
 from explaindrive.language.encoders import (
-    DEFAULT_ENCODER,
     DEFAULT_RUNTIME,
-    EncoderName,
+    ENCODER,
     EncoderRuntime,
-    check_encoder,
     check_runtime,
-    encoder_model_dir,
     encoder_threads,
+    minilm_model_dir,
 )
 from explaindrive.language.onnx_encoder import OnnxSentenceRunner, onnx_model_file
 
@@ -50,26 +48,22 @@ class SentenceEncoder:
         self,
         model_dir: Path | None = None,
         threads: int | None = None,
-        name: EncoderName = DEFAULT_ENCODER,
         runtime: EncoderRuntime = DEFAULT_RUNTIME,
     ) -> None:
         """Build an encoder (the model loads on first use).
 
         Args:
-            model_dir: model directory; ``None`` = the packaged model of encoder ``name``.
+            model_dir: model directory; ``None`` = all-MiniLM-L6-v2 as packaged.
             threads: threads used while encoding; ``None`` = the runtime's default
                 (:data:`~explaindrive.language.encoders.RUNTIME_THREADS`).
-            name: which encoder (:mod:`explaindrive.language.encoders`); recorded with
-                classifier weights so they are never used with another encoder.
             runtime: ``onnx`` (ONNX Runtime on a cached export, see
                 :mod:`explaindrive.language.onnx_encoder`) or ``torch``; both give the same
                 embeddings to float rounding.
 
         Raises:
-            ValueError: for an unknown encoder name or runtime.
+            ValueError: for an unknown runtime.
         """
         self.model_dir = model_dir
-        self.name = check_encoder(name)
         self.runtime = check_runtime(runtime)
         self.threads = encoder_threads(self.runtime, threads)
         self._model: Any = None
@@ -85,14 +79,14 @@ class SentenceEncoder:
         with self._lock:
             if self._model is not None or self._onnx is not None:
                 return
-            path = Path(self.model_dir or encoder_model_dir(self.name))
+            path = Path(self.model_dir or minilm_model_dir())
             if not path.is_dir():
                 raise FileNotFoundError(f"sentence-embedding model directory not found: {path}")
             os.environ.setdefault("HF_HUB_OFFLINE", "1")
             os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
             if self.runtime == "onnx":
                 log.info("loading sentence encoder %s on ONNX Runtime", path)
-                onnx_file = onnx_model_file(path, cache_dir(), self.name)
+                onnx_file = onnx_model_file(path, cache_dir(), ENCODER)
                 self._onnx = OnnxSentenceRunner(onnx_file, path, self.threads)
                 return
             from sentence_transformers import SentenceTransformer
@@ -171,7 +165,7 @@ class FeatureSpec:
     ngram_weight: float = NGRAM_WEIGHT
     cue_weight: float = CUE_WEIGHT
     n_cues: int = N_CUES
-    encoder: str = DEFAULT_ENCODER
+    encoder: str = ENCODER
     """The sentence encoder whose embeddings lead the feature row."""
 
 

@@ -15,8 +15,7 @@ off-topic only when its off-topic probability leads the best command's by more t
 ``COMMAND_DROP_COST`` off-topic requests answered with a confirmation question. Retrain
 and re-ship the weights with::
 
-    python -m explaindrive.language.intent_classifier                    # MiniLM (default)
-    python -m explaindrive.language.intent_classifier --encoder mpnet
+    python -m explaindrive.language.intent_classifier
 """
 
 from __future__ import annotations
@@ -33,7 +32,7 @@ from numpy.typing import NDArray
 from sklearn.linear_model import LogisticRegression
 
 from explaindrive.language.datasets import (
-    CLASSIFIER_FILES,
+    CLASSIFIER_NPZ,
     DEV_SPLITS,
     INTENT_LABELS,
     TRAIN_CSV,
@@ -41,13 +40,7 @@ from explaindrive.language.datasets import (
     data_path,
     load_commands,
 )
-from explaindrive.language.encoders import (
-    DEFAULT_ENCODER,
-    ENCODERS,
-    RUNTIMES,
-    EncoderRuntime,
-    check_encoder,
-)
+from explaindrive.language.encoders import ENCODER, RUNTIMES, EncoderRuntime
 from explaindrive.language.features import (
     FeatureSpec,
     SentenceEncoder,
@@ -161,17 +154,15 @@ class IntentClassifier:
         )
 
     @classmethod
-    def load(
-        cls, path: str | Path | None = None, encoder: str = DEFAULT_ENCODER
-    ) -> IntentClassifier:
-        """Read weights (default: the ones shipped for ``encoder``).
+    def load(cls, path: str | Path | None = None) -> IntentClassifier:
+        """Read weights (default: the shipped ones).
 
         Raises:
             FileNotFoundError: if the file is missing.
             ValueError: if it is not a classifier written by :meth:`save`, or was built
-                over another encoder's embeddings than ``encoder``.
+                over another encoder's embeddings.
         """
-        p = Path(path) if path is not None else data_path(CLASSIFIER_FILES[check_encoder(encoder)])
+        p = Path(path) if path is not None else data_path(CLASSIFIER_NPZ)
         if not p.is_file():
             raise FileNotFoundError(f"intent classifier weights not found: {p}")
         try:
@@ -189,8 +180,7 @@ class IntentClassifier:
                         float(z["ngram_weight"]),
                         float(z["cue_weight"]),
                         int(z["n_cues"]),
-                        # files without the key predate the choice: MiniLM was the only one
-                        str(z["encoder"]) if "encoder" in z.files else "minilm",
+                        str(z["encoder"]) if "encoder" in z.files else ENCODER,
                     ),
                     lr_weight=float(z["lr_weight"]),
                 )
@@ -198,11 +188,10 @@ class IntentClassifier:
             raise ValueError(f"{p}: not a valid intent classifier file ({exc})") from exc
         if labels != INTENT_LABELS:
             raise ValueError(f"{p}: labels {labels} differ from {INTENT_LABELS}")
-        if clf.spec.encoder != encoder:
+        if clf.spec.encoder != ENCODER:
             raise ValueError(
-                f"{p}: built over the {clf.spec.encoder!r} encoder's embeddings, not {encoder!r}; "
-                "use the matching encoder or rebuild with `python -m "
-                f"explaindrive.language.intent_classifier --encoder {encoder}`"
+                f"{p}: built over the {clf.spec.encoder!r} encoder's embeddings, not "
+                f"{ENCODER!r}; rebuild with `python -m explaindrive.language.intent_classifier`"
             )
         return clf
 
@@ -417,15 +406,10 @@ def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...
     return best[2]
 
 
-def fit_final(
-    train: Encoded, devs: list[Encoded], sel: Selection, encoder: str = DEFAULT_ENCODER
-) -> IntentClassifier:
-    """Fit the shipped model on the training and all development requests (embedded by
-    ``encoder``)."""
+def fit_final(train: Encoded, devs: list[Encoded], sel: Selection) -> IntentClassifier:
+    """Fit the shipped model on the training and all development requests."""
     hyper = sel.hyper
-    spec = FeatureSpec(
-        ngram_weight=hyper.ngram_weight, cue_weight=hyper.cue_weight, encoder=encoder
-    )
+    spec = FeatureSpec(ngram_weight=hyper.ngram_weight, cue_weight=hyper.cue_weight)
     pool = Encoded.concat([train, *devs])
     x = pool.features(spec)
     dim = train.emb.shape[1]
@@ -456,7 +440,7 @@ def train(
         sel.false_stops,
         sel.none_margin,
     )
-    return fit_final(tr, devs, sel, encoder.name), sel
+    return fit_final(tr, devs, sel), sel
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -471,9 +455,6 @@ def main(argv: list[str] | None = None) -> None:
         help="development splits (at least two; each is held out in turn)",
     )
     parser.add_argument(
-        "--encoder", choices=ENCODERS, default=DEFAULT_ENCODER, help="sentence encoder"
-    )
-    parser.add_argument(
         "--runtime",
         choices=RUNTIMES,
         default=BUILD_RUNTIME,
@@ -484,11 +465,11 @@ def main(argv: list[str] | None = None) -> None:
         "--out", type=Path, default=None, help="weights file (default: the shipped one)"
     )
     args = parser.parse_args(argv)
-    out = args.out or data_path(CLASSIFIER_FILES[args.encoder])
+    out = args.out or data_path(CLASSIFIER_NPZ)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     train_rows = load_commands(args.train)
     dev_rows = [load_commands(p) for p in args.dev]
-    clf, _ = train(train_rows, dev_rows, SentenceEncoder(name=args.encoder, runtime=args.runtime))
+    clf, _ = train(train_rows, dev_rows, SentenceEncoder(runtime=args.runtime))
     clf.save(out)
     log.info(
         "wrote %s (%d training + %d development requests)",

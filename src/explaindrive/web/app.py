@@ -34,7 +34,7 @@ from starlette.datastructures import UploadFile
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from explaindrive.language.backends import check_backend
-from explaindrive.language.encoders import DEFAULT_ENCODER, check_encoder
+from explaindrive.language.encoders import ENCODER, check_encoder
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.sim.scenario.files import default_scenario
@@ -75,10 +75,10 @@ class RealStack:
 
     Args:
         backend: language backend, ``embedded`` or ``openai``.
-        encoder: LLM-1 sentence encoder of the embedded backend (``minilm`` or ``mpnet``).
+        encoder: LLM-1 sentence encoder of the embedded backend (only ``minilm``).
     """
 
-    def __init__(self, backend: str = "embedded", encoder: str = DEFAULT_ENCODER) -> None:
+    def __init__(self, backend: str = "embedded", encoder: str = ENCODER) -> None:
         self.backend = check_backend(backend)
         self.encoder = check_encoder(encoder)
         self._controller: Any = None
@@ -95,8 +95,7 @@ class RealStack:
         if self._controller is None:
             self._controller = MergedController.from_package()
         if self._language is None:
-            language_config = LanguageConfig().with_encoder(self.encoder)
-            self._language = make_language_stack(self.backend, language_config).load()
+            self._language = make_language_stack(self.backend, LanguageConfig()).load()
         return RideSession(replace(config, backend=self.backend), self._controller, self._language)
 
 
@@ -104,7 +103,7 @@ def create_app(
     session_factory: SessionFactory | None = None,
     *,
     backend: str = "embedded",
-    encoder: str = DEFAULT_ENCODER,
+    encoder: str = ENCODER,
     step_period_s: float = 1.0,
     max_upload_bytes: int = MAX_UPLOAD_BYTES,
     max_audio_s: float = MAX_AUDIO_S,

@@ -27,7 +27,7 @@ NAME = "embedded"
 
 
 class EmbeddedIntentInterpreter(IntentInterpreter):
-    """LLM-1 offline: sentence-encoder features + the classifier shipped for that encoder."""
+    """LLM-1 offline: sentence-encoder features + the shipped classifier."""
 
     name = NAME
 
@@ -39,10 +39,9 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         self.encoder = encoder or SentenceEncoder(
             self.config.embedding_model_dir,
             self.config.encoder_threads,
-            self.config.encoder,
             self.config.encoder_runtime,
         )
-        self.classifier = IntentClassifier.load(self.config.classifier_path, self.encoder.name)
+        self.classifier = IntentClassifier.load(self.config.classifier_path)
 
     def load(self) -> None:
         """Load the sentence encoder now rather than on the first request."""
