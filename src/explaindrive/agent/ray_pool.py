@@ -10,6 +10,7 @@ restarted by Ray (``max_restarts=-1``); the round it was playing comes back as
 
 from __future__ import annotations
 
+import importlib.util
 import logging
 import os
 import time
@@ -27,16 +28,22 @@ log = logging.getLogger(__name__)
 RAY_MISSING = "Ray is not installed: pip install 'explaindrive[ray]'"
 
 
+def ray_installed() -> bool:
+    """Whether Ray (the optional extra) is installed; the one place that checks, without
+    importing it."""
+    return importlib.util.find_spec("ray") is not None
+
+
 def require_ray() -> ModuleType:
     """The ``ray`` module.
 
     Raises:
         ConfigError: naming the extra, if Ray is not installed.
     """
-    try:
-        import ray
-    except ImportError:
-        raise ConfigError(RAY_MISSING) from None
+    if not ray_installed():
+        raise ConfigError(RAY_MISSING)
+    import ray
+
     return ray
 
 

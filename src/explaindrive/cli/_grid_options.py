@@ -4,7 +4,6 @@ place each."""
 from __future__ import annotations
 
 import contextlib
-import importlib.util
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -55,10 +54,11 @@ def check_ray_target(ray: bool, ray_address: str | None) -> str | None:
     is given without Ray installed; else ``None``."""
     if ray and ray_address:
         return "give --ray or --ray-address, not both"
-    if (ray or ray_address) and importlib.util.find_spec("ray") is None:
-        from explaindrive.agent.ray_pool import RAY_MISSING
+    if ray or ray_address:
+        from explaindrive.agent.ray_pool import RAY_MISSING, ray_installed
 
-        return RAY_MISSING
+        if not ray_installed():
+            return RAY_MISSING
     return None
 
 
