@@ -9,6 +9,7 @@ import pytest
 
 from explaindrive.commands import Command
 from explaindrive.ride.config import RideConfig
+from explaindrive.ride.events import EventType
 from explaindrive.ride.runner import run_ride
 from explaindrive.ride.script import ScriptLine
 from explaindrive.ride.session import RideSession, check_deadlines
@@ -50,6 +51,7 @@ def test_confirmed_commands_take_effect_on_the_next_step(tmp_path):
     rows = [json.loads(x) for x in out.events.read_text().splitlines()]
     assert len(rows) == len(session.records)  # one line per step, none lost
     assert rows[20]["command"] == "stop" and set(rows[0]["state"]) >= {"v_ego", "d_tl"}
+    assert {e["type"] for row in rows for e in row["passenger"]} <= set(EventType)
     summary = json.loads(out.summary.read_text())
     assert summary["counts"]["confirmations"] == 3
     assert summary["metrics"]["collisions"] == 0

@@ -34,6 +34,7 @@ from explaindrive.language.intent import IntentResult
 from explaindrive.language.speech import AudioError
 from explaindrive.language.summary import StateRecord
 from explaindrive.ride.config import RideConfig
+from explaindrive.ride.events import EventType
 from explaindrive.ride.lane import EXPLANATION, LanguageLane, Outcome
 
 if TYPE_CHECKING:
@@ -202,7 +203,7 @@ class RideSession:
         """Answer the pending confirmation question; ``False`` if none was pending."""
         req = self.pending_confirmation
         if req is None:
-            self._note({"type": "answer_ignored", "reason": "no question pending"})
+            self._note({"type": EventType.ANSWER_IGNORED, "reason": "no question pending"})
             return False
         self._resolve(req, yes, source="passenger")
         return True
@@ -212,7 +213,12 @@ class RideSession:
         req = _Request(self._requests, self.t, text, audio, confirm)
         self.counts.requests += 1
         self._note(
-            {"type": "line", "id": req.id, "text": text, "audio": str(audio) if audio else None}
+            {
+                "type": EventType.LINE,
+                "id": req.id,
+                "text": text,
+                "audio": str(audio) if audio else None,
+            }
         )
         self.lane.submit(
             "interpret",
@@ -320,7 +326,7 @@ class RideSession:
         for out in outcomes:
             kind = out.task.kind
             if out.late or out.error:
-                what = "late" if out.late else "error"
+                what = EventType.LATE if out.late else EventType.ERROR
                 self.counts.late += out.late
                 self.counts.errors += out.error is not None
                 self._note(
@@ -347,7 +353,7 @@ class RideSession:
         if req.audio is not None:
             self._note(
                 {
-                    "type": "transcript",
+                    "type": EventType.TRANSCRIPT,
                     "id": req.id,
                     "text": text,
                     "latency_s": round(transcribe_s, 4),
@@ -357,7 +363,7 @@ class RideSession:
             self.counts.rephrase += 1
             self._note(
                 {
-                    "type": "rephrase",
+                    "type": EventType.REPHRASE,
                     "id": req.id,
                     "reason": problem,
                     "message": "Sorry, I did not catch that. Could you say it again?",
@@ -367,7 +373,7 @@ class RideSession:
         self.counts.fallbacks += int(result.fallback)
         self._note(
             {
-                "type": "interpretation",
+                "type": EventType.INTERPRETATION,
                 "id": req.id,
                 **result.to_json(),
                 "latency_s": round(out.latency_s, 4),
@@ -380,7 +386,7 @@ class RideSession:
         if req.id < self._newest_read:
             # a later request was understood first: the passenger's last instruction counts
             self.counts.superseded += 1
-            self._note({"type": "superseded", "id": req.id, "by": self._newest_read})
+            self._note({"type": EventType.SUPERSEDED, "id": req.id, "by": self._newest_read})
             return
         self.counts.understood += 1
         self._newest_read = req.id
@@ -393,7 +399,7 @@ class RideSession:
             self._resolve(req, True, source="auto")
         else:
             if self.pending_confirmation is not None:
-                self._note({"type": "superseded", "id": self.pending_confirmation.id})
+                self._note({"type": EventType.SUPERSEDED, "id": self.pending_confirmation.id})
             self.pending_confirmation = req
 
     def _resolve(self, req: _Request, yes: bool, source: str) -> None:
@@ -403,7 +409,7 @@ class RideSession:
             self.counts.cancellations += 1
             self._note(
                 {
-                    "type": "cancelled",
+                    "type": EventType.CANCELLED,
                     "id": req.id,
                     "answer": "no",
                     "source": source,
@@ -417,7 +423,7 @@ class RideSession:
         self.env.set_command(req.intent)
         self._note(
             {
-                "type": "confirmed",
+                "type": EventType.CONFIRMED,
                 "id": req.id,
                 "source": source,
                 "from": before.label,
