@@ -487,7 +487,7 @@ class RideSession:
         """Evaluation metrics of the ride plus the language counters."""
         res = self.metrics.result()
         return {
-            "config": {k: getattr(self.config, k) for k in self.config.__dataclass_fields__},
+            "config": self.config.to_dict(),
             "metrics": res.as_dict(),
             "counts": self.counts.__dict__.copy(),
             "final_command": self.controller.command.label,
