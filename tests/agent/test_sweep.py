@@ -5,12 +5,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import torch
-
-from explaindrive.agent.checkpoint import save_policy
-from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.sweep import evaluate_seeds, seed_run_dir
 from explaindrive.cli.train import seed_run_args
+from tests.helpers import constant_policy
 
 
 def test_every_seed_run_gets_the_same_options() -> None:
@@ -23,12 +20,7 @@ def test_every_seed_run_gets_the_same_options() -> None:
 
 
 def _constant_run(out: Path, seed: int, action: int) -> None:
-    net = DuelingQNetwork((4,))
-    with torch.no_grad():
-        for p in net.parameters():
-            p.zero_()
-        net.advantage.bias[action] = 1.0
-    save_policy(seed_run_dir(out, seed) / "policy.pt", net, {"name": "fast", "mode": "fast"})
+    constant_policy(seed_run_dir(out, seed) / "policy.pt", action, {"name": "fast", "mode": "fast"})
 
 
 def test_finished_seeds_are_evaluated_into_one_table(tmp_path: Path) -> None:

@@ -6,36 +6,28 @@ import json
 from pathlib import Path
 
 import pytest
-import torch
 from typer.testing import CliRunner
 
-from explaindrive.agent.checkpoint import save_policy
-from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.cli.main import app
 from explaindrive.env.actions import action_index
 from explaindrive.evaluation.runner import EpisodeRecord, run_episode, run_grid
 from explaindrive.evaluation.schema import SCHEMA_NAME, run_document, write_json
 from explaindrive.evaluation.spec import parse_policy, plan_run
+from tests.helpers import constant_policy
 
 MAX_STEPS = 25  # [steps] short episodes keep the suite fast
 SPLIT_S = 8.0  # [s] fast -> comfort switch of the merged run
 
 
-def constant_policy(path: Path, change_mps: int, mode: str) -> Path:
+def speed_change_policy(path: Path, change_mps: int, mode: str) -> Path:
     """A policy file whose greedy action is always ``change_mps``."""
-    net = DuelingQNetwork((4,))
-    with torch.no_grad():
-        for p in net.parameters():
-            p.zero_()
-        net.advantage.bias[action_index(change_mps)] = 1.0
-    out, _ = save_policy(path, net, {"mode": mode, "episodes": 0})
-    return out
+    return constant_policy(path, action_index(change_mps), {"mode": mode, "episodes": 0})
 
 
 @pytest.fixture(scope="module")
 def policies(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     root = tmp_path_factory.mktemp("policies")
-    return constant_policy(root / "fast.pt", 1, "fast"), constant_policy(
+    return speed_change_policy(root / "fast.pt", 1, "fast"), speed_change_policy(
         root / "comfort.pt", 0, "comfort"
     )
 
