@@ -22,7 +22,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from explaindrive.language.datasets import DEV_SPLITS, TRAIN_CSV, data_path, load_commands
+from explaindrive.language.datasets import TRAIN_CSV, data_path, load_commands, training_splits
 from explaindrive.language.encoders import RUNTIMES
 from explaindrive.language.features import SentenceEncoder
 from explaindrive.language.intent_classifier import (
@@ -47,8 +47,9 @@ def main() -> None:
         ngram_weight=spec.ngram_weight, cue_weight=spec.cue_weight, lr_weight=shipped.lr_weight
     )
     encoder = SentenceEncoder(runtime=args.runtime)
-    train = Encoded.of(load_commands(data_path(TRAIN_CSV)), encoder)
-    devs = [Encoded.of(load_commands(data_path(name)), encoder) for name in DEV_SPLITS]
+    train_rows, dev_rows = training_splits(load_commands(data_path(TRAIN_CSV)))
+    train = Encoded.of(train_rows, encoder)
+    devs = [Encoded.of(rows, encoder) for rows in dev_rows]
     p = held_out_proba(train, devs, spec, hyper.c, hyper)
     y = np.concatenate([d.y for d in devs])
     commands = y != NONE

@@ -11,12 +11,14 @@ from explaindrive.language.backends.embedded import RuleDecider, TemplateExplain
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
-    DEV_SPLITS,
-    TEST_SPLITS,
+    RESERVE_SPLIT,
+    TEST_CSV,
     TRAIN_CSV,
+    CommandExample,
     data_path,
     load_commands,
     load_decisions,
+    training_splits,
 )
 from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
 from explaindrive.language.explanation import present_factors
@@ -24,32 +26,37 @@ from explaindrive.language.explanation import present_factors
 NEAR_COPY = 0.8  # character similarity (difflib ratio) from which a text counts as a near-copy
 
 
-@pytest.mark.parametrize("dev_csv", DEV_SPLITS)
-def test_corpus_sizes_and_dev_splits(dev_csv: str) -> None:
-    train, dev = load_commands(data_path(TRAIN_CSV)), load_commands(data_path(dev_csv))
-    assert len(train) + len(dev) >= 400 and len(dev) >= 120
-    assert {r.text.lower() for r in train}.isdisjoint({r.text.lower() for r in dev})
-    counts = Counter(r.label for r in dev)
+def _texts(rows: list[CommandExample]) -> set[str]:
+    return {r.text.lower() for r in rows}
+
+
+def _balanced(rows: list[CommandExample], kinds: set[str]) -> None:
+    counts = Counter(r.label for r in rows)
     assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
-    assert {"direct", "indirect", "negation", "noise"} <= {r.kind for r in dev}
+    assert kinds <= {r.kind for r in rows}
 
 
-def test_dev_splits_are_disjoint() -> None:
-    splits = [{r.text.lower() for r in load_commands(data_path(n))} for n in DEV_SPLITS]
+def test_training_file_splits() -> None:
+    rows = load_commands(data_path(TRAIN_CSV))
+    train, devs = training_splits(rows)
+    reserve = [r for r in rows if r.split == RESERVE_SPLIT]
+    assert len(train) >= 400 and len(devs) >= 2 and len(reserve) >= 150
+    assert len(rows) == len(train) + sum(map(len, devs)) + len(reserve)
+    for split in (*devs, reserve):
+        assert len(split) >= 120
+        _balanced(split, {"direct", "indirect", "negation", "noise"})
+    # no request is in two splits
+    splits = [_texts(train), *map(_texts, devs), _texts(reserve)]
     for i, a in enumerate(splits):
         for b in splits[i + 1 :]:
             assert a.isdisjoint(b)
 
 
-@pytest.mark.parametrize("test_csv", TEST_SPLITS)
-def test_held_out_test_split(test_csv: str) -> None:
-    test = load_commands(data_path(test_csv))
-    assert len(test) >= 150
-    counts = Counter(r.label for r in test)
-    assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
-    assert {"direct", "indirect", "negation", "noise", "offtopic"} <= {r.kind for r in test}
-    others = (TRAIN_CSV, *DEV_SPLITS, *(t for t in TEST_SPLITS if t != test_csv))
-    seen = {r.text.lower() for name in others for r in load_commands(data_path(name))}
+def test_blind_test_file() -> None:
+    test = load_commands(data_path(TEST_CSV))
+    assert len(test) >= 150 and {r.split for r in test} == {""}
+    _balanced(test, {"direct", "indirect", "negation", "noise", "offtopic"})
+    seen = _texts(load_commands(data_path(TRAIN_CSV)))
     near_copies = [
         (t.text, s)
         for t in test
@@ -58,6 +65,26 @@ def test_held_out_test_split(test_csv: str) -> None:
         and SequenceMatcher(None, t.text.lower(), s).ratio() >= NEAR_COPY
     ]
     assert near_copies == []
+
+
+def test_training_splits_keep_file_order_and_number_the_dev_splits(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    p = tmp_path / "c.csv"
+    p.write_text(
+        "text,label,kind,split\n"
+        "a,fast,,dev-2\nb,stop,,train\nc,none,,dev-1\nd,comfort,,reserve\ne,fast,,dev-2\n"
+    )
+    train, devs = training_splits(load_commands(p))
+    assert [r.text for r in train] == ["b"]
+    assert [[r.text for r in d] for d in devs] == [["c"], ["a", "e"]]
+    p.write_text("text,label,split\na,fast,train\nb,stop,dev-1\nc,stop,dev-3\n")
+    with pytest.raises(ValueError, match="numbered 1 to N, got 1, 3"):
+        training_splits(load_commands(p))
+    p.write_text("text,label,split\na,fast,dev-1\n")
+    with pytest.raises(ValueError, match="no requests of split 'train'"):
+        training_splits(load_commands(p))
+    p.write_text("text,label,split\na,fast,train\nb,stop,test\n")
+    with pytest.raises(ValueError, match=r"c.csv:3: unknown split 'test'"):
+        load_commands(p)
 
 
 def test_decision_set() -> None:

@@ -14,7 +14,7 @@ from explaindrive.cache import cache_dir
 from explaindrive.language import onnx_encoder
 from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
 from explaindrive.language.config import EmbeddedConfig
-from explaindrive.language.datasets import DEV_SPLITS, data_path, load_commands
+from explaindrive.language.datasets import TRAIN_CSV, data_path, load_commands
 from explaindrive.language.encoders import check_runtime, minilm_model_dir
 from explaindrive.language.features import SentenceEncoder, normalize_text
 from explaindrive.language.onnx_encoder import export_dir, export_onnx, onnx_model_file
@@ -38,7 +38,8 @@ def test_onnx_matches_torch_on_requests_and_overlong_text(
     interpreter: EmbeddedIntentInterpreter,
 ) -> None:
     assert interpreter.encoder.runtime == "onnx"
-    texts = [normalize_text(r.text) for r in load_commands(data_path(DEV_SPLITS[0]))[:40]]
+    rows = [r for r in load_commands(data_path(TRAIN_CSV)) if r.split == "dev-1"][:40]
+    texts = [normalize_text(r.text) for r in rows]
     texts += ["", LONG]
     torch_encoder = SentenceEncoder(runtime="torch")
     onnx_emb = interpreter.encoder.encode(texts)

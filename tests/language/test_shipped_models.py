@@ -6,7 +6,13 @@ import numpy as np
 
 from explaindrive.commands import Command
 from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
-from explaindrive.language.datasets import DEV_SPLITS, INTENT_LABELS, data_path, load_commands
+from explaindrive.language.datasets import (
+    INTENT_LABELS,
+    TRAIN_CSV,
+    data_path,
+    load_commands,
+    training_splits,
+)
 from explaindrive.language.features import features
 from explaindrive.language.intent_classifier import decide_rows
 from explaindrive.ride.script import default_script_path, load_script
@@ -29,9 +35,8 @@ def test_default_ride_lines(interpreter: EmbeddedIntentInterpreter) -> None:
 
 
 def test_stop_recall_on_every_dev_split(interpreter: EmbeddedIntentInterpreter) -> None:
-    stops = [
-        r.text for name in DEV_SPLITS for r in load_commands(data_path(name)) if r.label == "stop"
-    ]
+    _, devs = training_splits(load_commands(data_path(TRAIN_CSV)))
+    stops = [r.text for dev in devs for r in dev if r.label == "stop"]
     clf = interpreter.classifier
     p = clf.proba(features(interpreter.encoder, stops, clf.spec))  # one batched pass
     pred = decide_rows(p, clf.stop_threshold, clf.none_margin)

@@ -1,14 +1,27 @@
-"""Readers for the shipped language datasets (with clear errors on bad files).
+"""Readers for the shipped language data (with clear errors on bad files).
 
-* Command corpus: CSV with columns ``text,label[,kind]``; label fast|comfort|stop|none.
-* Decision set: JSONL, one state record per line plus ``explain`` (bool) and
-  ``factor`` labels (and an optional ``id`` / ``note``).
+* Command files: CSV with columns ``text,label[,kind][,split]``. ``label`` is fast, comfort,
+  stop or none (off-topic); ``kind`` says what sort of request it is (direct, indirect,
+  negation, noise, offtopic, correction, tampered).
+* Decision file: JSONL, one state record per line plus ``explain`` (bool) and ``factor``
+  labels (and an optional ``id`` / ``note``).
+
+The ``split`` column of :data:`TRAIN_CSV` says what building LLM-1 does with a request:
+
+* ``train``: always fitted on.
+* ``dev-1`` ... ``dev-N``: the development splits. For the choice of hyper-parameters, the
+  STOP threshold and the none margin, each is predicted by a model fitted on ``train`` and
+  the other development splits; the shipped model is then fitted on ``train`` and all of
+  them (:mod:`explaindrive.language.intent_classifier`).
+* ``reserve``: neither fitted on nor used for choices by the shipped model; free for checks
+  and for a later model's development.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import re
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -20,6 +33,19 @@ from explaindrive.language.summary import StateRecord
 from explaindrive.validation import describe_errors
 
 INTENT_LABELS: tuple[str, ...] = ("fast", "comfort", "stop", "none")
+TRAIN_SPLIT = "train"
+DEV_PREFIX = "dev-"
+RESERVE_SPLIT = "reserve"
+_SPLIT = re.compile(rf"{TRAIN_SPLIT}|{RESERVE_SPLIT}|{DEV_PREFIX}[1-9][0-9]*")
+
+TRAIN_CSV = "commands_train.csv"
+"""Every labelled request a model may be built or selected on; the split column says how."""
+TEST_CSV = "commands_test.csv"
+"""The blind test requests, never used to build or select a model."""
+DECISIONS_JSONL = "decisions.jsonl"
+"""Labelled state records for the LLM-2 trigger and the LLM-3 explanations."""
+CLASSIFIER_NPZ = "intent_classifier.npz"
+"""The shipped LLM-1 weights over all-MiniLM-L6-v2."""
 
 
 def data_path(name: str) -> Path:
@@ -27,73 +53,15 @@ def data_path(name: str) -> Path:
     return Path(str(resources.files("explaindrive.language") / "data" / name))
 
 
-TRAIN_CSV = "commands_train.csv"
-"""Training requests."""
-DEV_CSV = "commands_dev.csv"
-"""Development requests: used for model selection and the STOP threshold."""
-DEV2_CSV = "commands_dev2.csv"
-"""Second development split (a former test split, evaluated once): selection and refit."""
-DEV3_CSV = "commands_dev3.csv"
-"""Third development split (a former test split, evaluated by two models)."""
-DEV4_CSV = "commands_dev4.csv"
-"""Fourth development split (a former test split, evaluated once)."""
-DEV5_CSV = "commands_dev5.csv"
-"""Fifth development split (a former test split, evaluated once)."""
-DEV6_CSV = "commands_dev6.csv"
-"""Sixth development split (the round-6 test split, evaluated by the round-6 model)."""
-DEV7_CSV = "commands_dev7.csv"
-"""Seventh development split (the round-7 test split, evaluated by the round-6 model)."""
-DEV8_CSV = "commands_dev8.csv"
-"""Eighth development split (the round-8 test split, evaluated by the round-8 model)."""
-DEV9_CSV = "commands_dev9.csv"
-"""Ninth development split (the round-9 test split, evaluated by the round-9 model)."""
-DEV10_CSV = "commands_dev10.csv"
-"""Tenth development split (the round-10 test split, evaluated by the round-10 model)."""
-DEV11_CSV = "commands_dev11.csv"
-"""The round-11 test split, evaluated once by the round-11 models."""
-DEV12_CSV = "commands_dev12.csv"
-"""The round-12 test split, evaluated once by the round-11 models and a withdrawn cascade."""
-DEV13_CSV = "commands_dev13.csv"
-"""The round-13 test split, evaluated once by the round-11 models."""
-DEV14_CSV = "commands_dev14.csv"
-"""The round-14 test split, evaluated once by the round-11 models."""
-DEV_SPLITS: tuple[str, ...] = (
-    DEV_CSV,
-    DEV2_CSV,
-    DEV3_CSV,
-    DEV4_CSV,
-    DEV5_CSV,
-    DEV6_CSV,
-    DEV7_CSV,
-    DEV8_CSV,
-    DEV9_CSV,
-    DEV10_CSV,
-    DEV11_CSV,
-    DEV12_CSV,
-    DEV13_CSV,
-    DEV14_CSV,
-)
-"""The development splits, each written in its own round; LLM-1 selection holds each out."""
-TEST10_CSV = "commands_test10.csv"
-"""Held-out requests written from the labelling guide alone and committed before any
-model judged on it was evaluated; never used to build a shipped model."""
-TEST_CSV = "commands_test11.csv"
-"""Held-out requests written from the labelling guide (self-corrections and off-topic
-remarks that mention places, arrivals and stops included), committed before any model
-was judged on it; never used to build a shipped model. The default of ``eval intents``."""
-TEST_SPLITS: tuple[str, ...] = (TEST10_CSV, TEST_CSV)
-DECISIONS_JSONL = "decisions.jsonl"
-CLASSIFIER_NPZ = "intent_classifier.npz"
-"""The shipped LLM-1 weights over all-MiniLM-L6-v2."""
-
-
 @dataclass(frozen=True, slots=True)
 class CommandExample:
-    """One labelled passenger request; ``label`` is ``none`` for off-topic requests."""
+    """One labelled passenger request; ``label`` is ``none`` for off-topic requests and
+    ``split`` is empty in a file without that column."""
 
     text: str
     label: str
     kind: str = ""
+    split: str = ""
 
 
 def load_commands(path: str | Path) -> list[CommandExample]:
@@ -101,7 +69,8 @@ def load_commands(path: str | Path) -> list[CommandExample]:
 
     Raises:
         FileNotFoundError: if the file is missing.
-        ValueError: on missing columns, an empty text or an unknown label (with line number).
+        ValueError: on missing columns, an empty text, an unknown label or split (with line
+            number).
     """
     p = Path(path)
     if not p.is_file():
@@ -109,7 +78,7 @@ def load_commands(path: str | Path) -> list[CommandExample]:
     with p.open(newline="", encoding="utf-8") as fh:
         reader = csv.DictReader(fh)
         if reader.fieldnames is None or not {"text", "label"} <= set(reader.fieldnames):
-            raise ValueError(f"{p}: expected a CSV header with columns text,label[,kind]")
+            raise ValueError(f"{p}: expected a CSV header with columns text,label[,kind][,split]")
         out: list[CommandExample] = []
         for line, row in enumerate(reader, start=2):
             text = (row.get("text") or "").strip()
@@ -120,10 +89,39 @@ def load_commands(path: str | Path) -> list[CommandExample]:
                 raise ValueError(
                     f"{p}:{line}: unknown label {label!r}; expected one of {INTENT_LABELS}"
                 )
-            out.append(CommandExample(text, label, (row.get("kind") or "").strip()))
+            split = (row.get("split") or "").strip()
+            if "split" in reader.fieldnames and not _SPLIT.fullmatch(split):
+                raise ValueError(
+                    f"{p}:{line}: unknown split {split!r}; expected {TRAIN_SPLIT}, "
+                    f"{DEV_PREFIX}<k> or {RESERVE_SPLIT}"
+                )
+            out.append(CommandExample(text, label, (row.get("kind") or "").strip(), split))
     if not out:
         raise ValueError(f"{p}: no rows")
     return out
+
+
+def training_splits(
+    rows: list[CommandExample],
+) -> tuple[list[CommandExample], list[list[CommandExample]]]:
+    """The ``train`` requests and the development splits ``dev-1`` ... ``dev-N`` in order,
+    each in file order; ``reserve`` requests are left out.
+
+    Raises:
+        ValueError: if there are no ``train`` requests, or the development splits are not
+            numbered 1 to N.
+    """
+    train = [r for r in rows if r.split == TRAIN_SPLIT]
+    devs: dict[int, list[CommandExample]] = {}
+    for r in rows:
+        if r.split.startswith(DEV_PREFIX):
+            devs.setdefault(int(r.split.removeprefix(DEV_PREFIX)), []).append(r)
+    if not train:
+        raise ValueError(f"no requests of split {TRAIN_SPLIT!r}")
+    if sorted(devs) != list(range(1, len(devs) + 1)):
+        numbers = ", ".join(map(str, sorted(devs)))
+        raise ValueError(f"development splits must be numbered 1 to N, got {numbers}")
+    return train, [devs[k] for k in sorted(devs)]
 
 
 class LabelledRecord(StateRecord):

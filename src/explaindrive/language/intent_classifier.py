@@ -3,9 +3,10 @@ word n-grams, direction cues), blended with a nearest-neighbour vote over the tr
 requests' embeddings.
 
 Protocol: the hyper-parameters (:class:`Hyper`: C, n-gram and cue weights, blend) are
-chosen on the development splits, each held out in turn from a model fitted on the
-training requests and the other development splits; the shipped model is then refitted
-on all of them. The held-out test split is never read here.
+chosen on the development splits (``dev-1`` ... ``dev-N`` in the ``split`` column of
+``commands_train.csv``, see :mod:`explaindrive.language.datasets`), each held out in turn
+from a model fitted on the training requests and the other development splits; the
+shipped model is then refitted on all of them. The test file is never read here.
 
 STOP is safety-critical: it wins whenever its probability reaches ``stop_threshold``. The
 threshold minimises a cost in which a missed STOP counts ``STOP_MISS_COST`` times a false
@@ -33,12 +34,12 @@ from sklearn.linear_model import LogisticRegression
 
 from explaindrive.language.datasets import (
     CLASSIFIER_NPZ,
-    DEV_SPLITS,
     INTENT_LABELS,
     TRAIN_CSV,
     CommandExample,
     data_path,
     load_commands,
+    training_splits,
 )
 from explaindrive.language.encoders import ENCODER, RUNTIMES, EncoderRuntime
 from explaindrive.language.features import (
@@ -78,8 +79,8 @@ class Hyper:
     """Blend: ``p = lr_weight * p_logreg + (1 - lr_weight) * p_knn``."""
 
 
-# Narrowed after rounds 4 and 5, where C=10, no cues and a pure logistic regression
-# (lr_weight 1) never came first on the held-out development splits.
+# C=10, no cues and a pure logistic regression (lr_weight 1) never came first on the
+# held-out development splits, so the grid leaves them out.
 SELECTION_GRID: dict[str, tuple[float, ...]] = {
     "c": (100.0,),
     "ngram_weight": (1.0, 1.5),
@@ -364,7 +365,7 @@ def select(train: Encoded, devs: list[Encoded], grid: dict[str, tuple[float, ...
 
     Each development split is predicted by a model fitted on the training requests and
     the other development splits (leave one split out), so every split is judged by a
-    model that never saw it and was written in another round. For each candidate the
+    model that never saw it. For each candidate the
     STOP threshold is tuned on the pooled held-out probabilities
     (:func:`tune_stop_threshold`); the candidate with the lowest :func:`selection_cost` at
     its threshold wins (ties: fewer false STOPs, then earlier in the grid).
@@ -444,15 +445,15 @@ def train(
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Retrain the shipped classifier from the shipped training and development splits."""
+    """Retrain the shipped classifier from the training and development splits of the
+    shipped ``commands_train.csv``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--train", type=Path, default=data_path(TRAIN_CSV))
     parser.add_argument(
-        "--dev",
+        "--data",
         type=Path,
-        nargs="+",
-        default=[data_path(n) for n in DEV_SPLITS],
-        help="development splits (at least two; each is held out in turn)",
+        default=data_path(TRAIN_CSV),
+        help="command CSV with a split column (train, dev-1 ... dev-N, reserve; at least "
+        "two development splits, each held out in turn)",
     )
     parser.add_argument(
         "--runtime",
@@ -467,8 +468,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     out = args.out or data_path(CLASSIFIER_NPZ)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    train_rows = load_commands(args.train)
-    dev_rows = [load_commands(p) for p in args.dev]
+    train_rows, dev_rows = training_splits(load_commands(args.data))
     clf, _ = train(train_rows, dev_rows, SentenceEncoder(runtime=args.runtime))
     clf.save(out)
     log.info(
