@@ -71,19 +71,19 @@ def test_transcribe_and_interpret_audio(transcriber, speak, tmp_path) -> None:  
     assert res.exit_code == 2 and "not found" in res.output
 
 
-def test_eval_decisions_writes_report(tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_score_decisions_writes_report(tmp_path) -> None:  # type: ignore[no-untyped-def]
     out = tmp_path / "dec.json"
-    res = runner.invoke(app, ["eval", "decisions", "--json", str(out)])
+    res = runner.invoke(app, ["score", "decisions", "--json", str(out)])
     assert res.exit_code == 0, res.output
     report = json.loads(out.read_text())
     assert report["n"] >= 80 and report["accuracy"] == 1.0 and report["factor_accuracy"] == 1.0
 
 
-def test_eval_intents_small_file(tmp_path, interpreter) -> None:  # type: ignore[no-untyped-def]
+def test_score_intents_small_file(tmp_path, interpreter) -> None:  # type: ignore[no-untyped-def]
     data = tmp_path / "c.csv"
     data.write_text("text,label\nPull over now,stop\nPlease speed up,fast\nPlay music,none\n")
     out = tmp_path / "r.json"
-    res = runner.invoke(app, ["eval", "intents", "--data", str(data), "--json", str(out)])
+    res = runner.invoke(app, ["score", "intents", "--data", str(data), "--json", str(out)])
     assert res.exit_code == 0, res.output
     r = json.loads(out.read_text())
     assert r["n_commands"] == 2 and r["template_compliance"] == 1.0

@@ -1,14 +1,18 @@
-"""``explaindrive eval ...``: a sub-command group other modules add evaluations to."""
+"""``explaindrive score ...``: the command group that scores the language layer on labelled
+data (its commands are added by :mod:`explaindrive.cli.eval_language`)."""
 
 from __future__ import annotations
 
 import typer
 
-eval_app = typer.Typer(
-    name="eval", help="Quantitative evaluations.", no_args_is_help=True, add_completion=False
+score_app = typer.Typer(
+    name="score",
+    help="Score the language layer on labelled data.",
+    no_args_is_help=True,
+    add_completion=False,
 )
 
 
 def register(app: typer.Typer) -> None:
-    """Mount the ``eval`` group on the root command."""
-    app.add_typer(eval_app, name="eval")
+    """Mount the ``score`` group on the root command."""
+    app.add_typer(score_app, name="score")

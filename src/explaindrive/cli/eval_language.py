@@ -1,4 +1,4 @@
-"""``explaindrive eval intents|decisions``: evaluate LLM-1 and LLM-2/LLM-3 on labelled data."""
+"""``explaindrive score intents|decisions``: score LLM-1 and LLM-2/LLM-3 on labelled data."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from explaindrive.cli._language_common import (
     fail,
     load_config,
 )
-from explaindrive.cli.eval_cmd import eval_app
+from explaindrive.cli.eval_cmd import score_app
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
     TEST_CSV,
@@ -104,6 +104,6 @@ def decisions_command(
 
 
 def register(app: typer.Typer) -> None:
-    """Add ``intents`` and ``decisions`` to the ``eval`` group."""
-    eval_app.command("intents")(intents_command)
-    eval_app.command("decisions")(decisions_command)
+    """Add ``intents`` and ``decisions`` to the ``score`` group."""
+    score_app.command("intents")(intents_command)
+    score_app.command("decisions")(decisions_command)
