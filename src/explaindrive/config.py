@@ -104,7 +104,7 @@ class ConfigModel(StrictModel):
 
 
 def config_error(exc: ValidationError, model: type[ConfigModel]) -> ConfigError:
-    """One :class:`ConfigError` line for every problem ``exc`` found in a ``model``.
+    """A :class:`ConfigError` whose one line names every problem ``exc`` found in a ``model``.
 
     Unknown keys come first, with the keys ``model`` knows:
     ``"unknown env config key(s): max_step; known keys: cache_dir, ...; invalid env

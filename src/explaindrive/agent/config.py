@@ -42,8 +42,8 @@ TRAIN_MODES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
 LOSSES: tuple[str, ...] = ("mse", "huber")
 SEED_POOL_BASE = 100_000  # training seeds from a pool start here, clear of evaluation seeds
 
-Fraction = Annotated[float, Field(ge=0.0, le=1.0)]
-Range = Annotated[tuple[float, float], FROM_LIST]
+Fraction = Annotated[float, Field(ge=0.0, le=1.0)]  # a probability or a share
+Range = Annotated[tuple[float, float], FROM_LIST]  # [min, max], 0 < min <= max
 
 
 class TrainConfig(ConfigModel):
