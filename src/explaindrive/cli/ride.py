@@ -46,6 +46,7 @@ console = Console()
 EXIT_INTERRUPTED = 130  # the shell's status for a command ended by Ctrl+C
 
 
+# What the passenger says, and how requests are confirmed
 ScriptOption = Annotated[
     Path | None, typer.Option("--script", help="Timed passenger lines (YAML/JSON).")
 ]
@@ -55,26 +56,29 @@ InteractiveOption = Annotated[
 VoiceOption = Annotated[
     bool, typer.Option("--voice", help="With --interactive: speak from the microphone.")
 ]
-BackendOption = Annotated[
-    str, typer.Option("--backend", help="Language backend: embedded or openai.")
-]
-EncoderOption = Annotated[str, typer.Option("--encoder", help=ENCODER_HELP)]
-TrafficOption = Annotated[float, typer.Option("--traffic", help="Traffic level (1.0 = 900 veh/h).")]
-SeedOption = Annotated[int, typer.Option("--seed", help="Simulation seed.")]
-GuiOption = Annotated[bool, typer.Option("--gui", help="Show the ride in sumo-gui.")]
-RealtimeOption = Annotated[bool, typer.Option("--realtime", help="One step per second.")]
-OutOption = Annotated[Path, typer.Option("--out", help="Output directory (empty or new).")]
-ForceOption = Annotated[
-    bool, typer.Option("--force", help="Replace the ride already in --out instead of refusing.")
-]
 AutoConfirmOption = Annotated[
     bool, typer.Option("--auto-confirm", help="Answer every question with yes.")
 ]
 StopWithoutConfirmOption = Annotated[
     bool, typer.Option("--stop-without-confirm", help="Apply STOP requests without asking.")
 ]
-MaxStepsOption = Annotated[int, typer.Option("--max-steps", help="Longest ride [s].")]
+# The language modules
+BackendOption = Annotated[
+    str, typer.Option("--backend", help="Language backend: embedded or openai.")
+]
+EncoderOption = Annotated[str, typer.Option("--encoder", help=ENCODER_HELP)]
 CooldownOption = Annotated[float, typer.Option("--cooldown", help="Explanation cool-down [s].")]
+# The simulation
+TrafficOption = Annotated[float, typer.Option("--traffic", help="Traffic level (1.0 = 900 veh/h).")]
+SeedOption = Annotated[int, typer.Option("--seed", help="Simulation seed.")]
+MaxStepsOption = Annotated[int, typer.Option("--max-steps", help="Longest ride [s].")]
+GuiOption = Annotated[bool, typer.Option("--gui", help="Show the ride in sumo-gui.")]
+RealtimeOption = Annotated[bool, typer.Option("--realtime", help="One step per second.")]
+# What the ride leaves behind, and the terminal view
+OutOption = Annotated[Path, typer.Option("--out", help="Output directory (empty or new).")]
+ForceOption = Annotated[
+    bool, typer.Option("--force", help="Replace the ride already in --out instead of refusing.")
+]
 LiveOption = Annotated[bool, typer.Option("--live/--no-live", help="Live terminal view.")]
 
 
