@@ -51,16 +51,28 @@ def speak(tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-
     return _speak
 
 
-class ScriptedOpenAI:
-    """A tiny OpenAI-compatible chat endpoint on 127.0.0.1 that replays scripted answers.
+def chat_completion(text: str, model: str) -> bytes:
+    """The JSON body of an OpenAI chat completion whose one choice says ``text``."""
+    message = {"role": "assistant", "content": text}
+    return json.dumps(
+        {
+            "id": f"chatcmpl-{model}",
+            "object": "chat.completion",
+            "created": 0,
+            "model": model,
+            "choices": [{"index": 0, "finish_reason": "stop", "message": message}],
+        }
+    ).encode()
 
-    Each entry of ``script`` is ``("ok", text)``, ``("slow", seconds, text)`` or
-    ``("http", status)``; the last entry repeats. ``requests`` records every request body.
+
+class LocalChatServer:
+    """An OpenAI-compatible address on 127.0.0.1 (a free port), served by a thread.
+
+    Every POST body is recorded in ``bodies``, then :meth:`answer` replies.
     """
 
     def __init__(self) -> None:
-        self.script: list[tuple[Any, ...]] = [("ok", "[EXPLAIN]")]
-        self.requests: list[dict[str, Any]] = []
+        self.bodies: list[dict[str, Any]] = []
         outer = self
 
         class Handler(BaseHTTPRequestHandler):
@@ -69,45 +81,51 @@ class ScriptedOpenAI:
 
             def do_POST(self) -> None:
                 length = int(self.headers.get("Content-Length", "0"))
-                outer.requests.append(json.loads(self.rfile.read(length) or b"{}"))
-                step = outer.script.pop(0) if len(outer.script) > 1 else outer.script[0]
-                if step[0] == "http":
-                    body = json.dumps({"error": {"message": "scripted failure"}}).encode()
-                    self.send_response(step[1])
-                else:
-                    if step[0] == "slow":
-                        time.sleep(step[1])
-                    text = step[-1]
-                    body = json.dumps(
-                        {
-                            "id": "chatcmpl-test",
-                            "object": "chat.completion",
-                            "created": 0,
-                            "model": "scripted",
-                            "choices": [
-                                {
-                                    "index": 0,
-                                    "finish_reason": "stop",
-                                    "message": {"role": "assistant", "content": text},
-                                }
-                            ],
-                        }
-                    ).encode()
-                    self.send_response(200)
-                self.send_header("Content-Type", "application/json")
-                self.send_header("Content-Length", str(len(body)))
-                self.end_headers()
-                with contextlib.suppress(BrokenPipeError):  # the client timed out first
-                    self.wfile.write(body)
+                outer.bodies.append(json.loads(self.rfile.read(length) or b"{}"))
+                outer.answer(self)
 
         self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.server.daemon_threads = True
         self.base_url = f"http://127.0.0.1:{self.server.server_address[1]}/v1"
         self.thread = threading.Thread(target=self.server.serve_forever, daemon=True)
         self.thread.start()
 
+    def answer(self, handler: BaseHTTPRequestHandler) -> None:
+        """Reply to the request ``handler`` has just read."""
+        raise NotImplementedError
+
     def close(self) -> None:
         self.server.shutdown()
         self.server.server_close()
+
+
+class ScriptedOpenAI(LocalChatServer):
+    """A chat endpoint that replays scripted answers.
+
+    Each entry of ``script`` is ``("ok", text)``, ``("slow", seconds, text)`` or
+    ``("http", status)``; the last entry repeats. ``requests`` holds every request body.
+    """
+
+    def __init__(self) -> None:
+        self.script: list[tuple[Any, ...]] = [("ok", "[EXPLAIN]")]
+        super().__init__()
+        self.requests = self.bodies
+
+    def answer(self, handler: BaseHTTPRequestHandler) -> None:
+        step = self.script.pop(0) if len(self.script) > 1 else self.script[0]
+        if step[0] == "http":
+            body = json.dumps({"error": {"message": "scripted failure"}}).encode()
+            handler.send_response(step[1])
+        else:
+            if step[0] == "slow":
+                time.sleep(step[1])
+            body = chat_completion(step[-1], "scripted")
+            handler.send_response(200)
+        handler.send_header("Content-Type", "application/json")
+        handler.send_header("Content-Length", str(len(body)))
+        handler.end_headers()
+        with contextlib.suppress(BrokenPipeError):  # the client timed out first
+            handler.wfile.write(body)
 
 
 @pytest.fixture()
@@ -118,8 +136,8 @@ def openai_server() -> Iterator[ScriptedOpenAI]:
     srv.close()
 
 
-class MisbehavingEndpoint:
-    """An OpenAI-compatible address on 127.0.0.1 that never answers in time.
+class MisbehavingEndpoint(LocalChatServer):
+    """A chat endpoint that never answers in time.
 
     ``mode="hang"`` reads the request and sends nothing; ``mode="drip"`` sends a valid
     HTTP response (status line, headers and a chat completion) one byte every
@@ -130,56 +148,28 @@ class MisbehavingEndpoint:
         if mode not in ("hang", "drip"):
             raise ValueError(f"unknown mode {mode!r}")
         self.mode = mode
-        self.bodies: list[dict[str, Any]] = []
+        self.interval_s = interval_s
         self._closed = threading.Event()
-        outer = self
+        super().__init__()
 
-        class Handler(BaseHTTPRequestHandler):
-            def log_message(self, *args: Any) -> None:
-                pass
-
-            def do_POST(self) -> None:
-                length = int(self.headers.get("Content-Length", "0"))
-                outer.bodies.append(json.loads(self.rfile.read(length) or b"{}"))
-                if outer.mode == "hang":
-                    outer._closed.wait(60.0)
-                    return
-                body = json.dumps(
-                    {
-                        "id": "chatcmpl-drip",
-                        "object": "chat.completion",
-                        "created": 0,
-                        "model": "drip",
-                        "choices": [
-                            {
-                                "index": 0,
-                                "finish_reason": "stop",
-                                "message": {
-                                    "role": "assistant",
-                                    "content": "You want me to drive faster, is this correct?",
-                                },
-                            }
-                        ],
-                    }
-                ).encode()
-                head = (
-                    "HTTP/1.1 200 OK\r\nContent-Type: application/json\r\n"
-                    f"Content-Length: {len(body)}\r\n\r\n"
-                ).encode()
-                for i in range(len(head + body)):
-                    if outer._closed.wait(interval_s):
-                        return
-                    with contextlib.suppress(OSError):  # the client gave up
-                        self.wfile.write((head + body)[i : i + 1])
-                        self.wfile.flush()
-                        continue
-                    return
-
-        self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
-        self.server.daemon_threads = True
-        self.base_url = f"http://127.0.0.1:{self.server.server_address[1]}/v1"
-        self.thread = threading.Thread(target=self.server.serve_forever, daemon=True)
-        self.thread.start()
+    def answer(self, handler: BaseHTTPRequestHandler) -> None:
+        if self.mode == "hang":
+            self._closed.wait(60.0)
+            return
+        body = chat_completion("You want me to drive faster, is this correct?", "drip")
+        head = (
+            "HTTP/1.1 200 OK\r\nContent-Type: application/json\r\n"
+            f"Content-Length: {len(body)}\r\n\r\n"
+        ).encode()
+        reply = head + body
+        for i in range(len(reply)):
+            if self._closed.wait(self.interval_s):
+                return
+            try:
+                handler.wfile.write(reply[i : i + 1])
+                handler.wfile.flush()
+            except OSError:  # the client gave up
+                return
 
     @property
     def requests(self) -> int:
@@ -192,8 +182,7 @@ class MisbehavingEndpoint:
 
     def close(self) -> None:
         self._closed.set()
-        self.server.shutdown()
-        self.server.server_close()
+        super().close()
 
 
 @pytest.fixture(params=["hang", "drip"])

@@ -76,10 +76,24 @@ def export_onnx(model_dir: Path, target: Path) -> Path:
     """
     if not (model_dir / "modules.json").is_file():
         raise FileNotFoundError(f"not a sentence-transformers model directory: {model_dir}")
+    log.info("exporting %s to ONNX (once) into %s", model_dir, target)
+    module, probe = _embedding_module(model_dir)
+    expected = _torch_embeddings(module, probe)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=target.parent, prefix=f".{target.name}-") as tmp:
+        staged = Path(tmp) / target.name
+        staged.mkdir()
+        _write_onnx(module, probe, staged / ONNX_FILE, model_dir)
+        worst = _export_error(staged / ONNX_FILE, model_dir, expected)
+        return publish(staged, target, f"max |onnx - torch| = {worst:.3e}\n")
+
+
+def _embedding_module(model_dir: Path) -> tuple[Any, tuple[Any, Any]]:
+    """The model as one PyTorch module from token ids and attention mask to unit-norm
+    embeddings, and those inputs for the probe sentences."""
     import torch
     from sentence_transformers import SentenceTransformer
 
-    log.info("exporting %s to ONNX (once) into %s", model_dir, target)
     model = SentenceTransformer(str(model_dir), device="cpu", local_files_only=True).eval()
 
     class _Embed(torch.nn.Module):
@@ -93,43 +107,63 @@ def export_onnx(model_dir: Path, target: Path) -> Path:
 
     prepare = getattr(model, "preprocess", None) or model.tokenize
     probe = prepare(list(_PROBES))
-    args = (probe["input_ids"], probe["attention_mask"])
+    return _Embed(), (probe["input_ids"], probe["attention_mask"])
+
+
+def _torch_embeddings(module: Any, probe: tuple[Any, Any]) -> NDArray[np.float32]:
+    """PyTorch's embeddings of the probe sentences, which the export must reproduce."""
+    import torch
+
     with torch.inference_mode():
-        expected = _Embed()(*args).numpy()
-    target.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=target.parent, prefix=f".{target.name}-") as tmp:
-        staged = Path(tmp) / target.name
-        staged.mkdir()
-        try:
-            with warnings.catch_warnings():  # tracer notes on branches fixed for this model
-                warnings.simplefilter("ignore")
-                torch.onnx.export(
-                    _Embed(),
-                    args,
-                    str(staged / ONNX_FILE),
-                    input_names=["input_ids", "attention_mask"],
-                    output_names=["embedding"],
-                    dynamic_axes={
-                        "input_ids": {0: "batch", 1: "tokens"},
-                        "attention_mask": {0: "batch", 1: "tokens"},
-                        "embedding": {0: "batch"},
-                    },
-                    opset_version=17,
-                    dynamo=False,
-                )
-        except Exception as exc:  # any exporter failure: say what to do instead
-            raise RuntimeError(
-                f"exporting {model_dir} to ONNX failed ({type(exc).__name__}: {exc}); "
-                "use encoder_runtime: torch"
-            ) from exc
-        got = OnnxSentenceRunner(staged / ONNX_FILE, model_dir, threads=1).embed(list(_PROBES))
-        worst = float(np.max(np.abs(got - expected)))
-        if worst > EXPORT_TOLERANCE:
-            raise RuntimeError(
-                f"the ONNX export of {model_dir} differs from PyTorch by {worst:.2e} "
-                f"(> {EXPORT_TOLERANCE:g}); use encoder_runtime: torch"
+        return np.asarray(module(*probe).numpy(), dtype=np.float32)
+
+
+def _write_onnx(module: Any, probe: tuple[Any, Any], onnx_file: Path, model_dir: Path) -> None:
+    """Trace ``module`` on the probe inputs into ``onnx_file``, batch and length left free.
+
+    Raises:
+        RuntimeError: if the exporter fails.
+    """
+    import torch
+
+    try:
+        with warnings.catch_warnings():  # tracer notes on branches fixed for this model
+            warnings.simplefilter("ignore")
+            torch.onnx.export(
+                module,
+                probe,
+                str(onnx_file),
+                input_names=["input_ids", "attention_mask"],
+                output_names=["embedding"],
+                dynamic_axes={
+                    "input_ids": {0: "batch", 1: "tokens"},
+                    "attention_mask": {0: "batch", 1: "tokens"},
+                    "embedding": {0: "batch"},
+                },
+                opset_version=17,
+                dynamo=False,
             )
-        return publish(staged, target, f"max |onnx - torch| = {worst:.3e}\n")
+    except Exception as exc:  # any exporter failure: say what to do instead
+        raise RuntimeError(
+            f"exporting {model_dir} to ONNX failed ({type(exc).__name__}: {exc}); "
+            "use encoder_runtime: torch"
+        ) from exc
+
+
+def _export_error(onnx_file: Path, model_dir: Path, expected: NDArray[np.float32]) -> float:
+    """Largest ``|ONNX - PyTorch|`` embedding component on the probe sentences.
+
+    Raises:
+        RuntimeError: if it exceeds :data:`EXPORT_TOLERANCE`.
+    """
+    got = OnnxSentenceRunner(onnx_file, model_dir, threads=1).embed(list(_PROBES))
+    worst = float(np.max(np.abs(got - expected)))
+    if worst > EXPORT_TOLERANCE:
+        raise RuntimeError(
+            f"the ONNX export of {model_dir} differs from PyTorch by {worst:.2e} "
+            f"(> {EXPORT_TOLERANCE:g}); use encoder_runtime: torch"
+        )
+    return worst
 
 
 def load_tokenizer(model_dir: Path) -> Any:
