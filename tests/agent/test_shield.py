@@ -1,11 +1,8 @@
 """The kinematic safety shield against hand-computed cases."""
 
 import numpy as np
-import pytest
 
 from explaindrive.agent.shield import (
-    braking_distance,
-    braking_distances,
     is_safe,
     runtime_mask,
     safe_action_mask,
@@ -18,15 +15,6 @@ from explaindrive.env.actions import action_index
 
 def obs(v=10.0, lim=13.89, d_lead=200.0, dv=0.0, d_tl=200.0, tls=0, d_cross=200.0, cmd=0):
     return np.array([cmd, v, lim, d_lead, dv, d_tl, tls, d_cross], dtype=np.float32)
-
-
-@pytest.mark.parametrize(
-    ("v", "brake", "expected"),
-    [(13, 3, 22.0), (6, 3, 3.0), (3, 3, 0.0), (0, 3, 0.0), (10, 9, 1.0), (10, 4.5, 6.5)],
-)
-def test_braking_distance(v, brake, expected):
-    # 13 -> 10 + 7 + 4 + 1; 6 -> 3; 10 at 9 -> 1; 10 at 4.5 -> 5.5 + 1
-    assert braking_distance(v, brake) == pytest.approx(expected)
 
 
 def test_speed_limit():
@@ -82,12 +70,6 @@ def test_stop_in_time():
     # with 1 step left only a standstill in this step will do
     assert not stop_in_time(3.0, action_index(-1), 1)
     assert stop_in_time(3.0, action_index(-3), 1)
-
-
-def test_braking_distances_of_a_batch_match_the_step_sum() -> None:
-    speeds = np.array([13.0, 6.0, 3.0, 0.0, 9.5, 1.0])
-    # 10+7+4+1, 3, 0, 0, 6.5+3.5+0.5, 0
-    assert braking_distances(speeds).tolist() == pytest.approx([22, 3, 0, 0, 10.5, 0])
 
 
 def test_mask_of_a_batch_is_the_mask_of_each_row() -> None:

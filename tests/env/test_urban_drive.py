@@ -214,3 +214,29 @@ def test_truncation_is_distinct_from_termination(make_env):
     assert truncated and not terminated
     with pytest.raises(RuntimeError, match="episode is over"):
         env.step(action_index(0))
+
+
+def test_pedestrians_do_not_step_in_front_of_the_ego_at_the_zebra(make_env):
+    """While the ego is on the zebra, or could not stop before it any more, nobody steps on."""
+    env = make_env()
+    zebra = next(c for c in env.geometry.crossings if not c.signalized)
+    length = env._ego_length_m
+    held_steps = 0
+    for seed in range(6):
+        obs, _ = env.reset(seed=seed, options={"traffic_level": 1.25})
+        api, driver = env.sumo, CautiousDriver()
+        on_crossing = set(api.edge.getLastStepPersonIDs(zebra.crossing_edge))
+        for _ in range(400):
+            front = env._episode().pos_m
+            obs, _, terminated, truncated, info = env.step(driver(obs))
+            assert not info["collision"], seed
+            now = set(api.edge.getLastStepPersonIDs(zebra.crossing_edge))
+            if zebra.stop_line_m <= front and front - length < zebra.end_m:
+                assert now <= on_crossing, (seed, front, now - on_crossing)
+            held = [p for p in api.person.getIDList() if env._episode().kerb.holds(p)]
+            held_steps += len(held)
+            assert all(api.person.getSpeed(p) == 0.0 for p in held)
+            on_crossing = now
+            if terminated or truncated or front > zebra.end_m + 50.0:
+                break
+    assert held_steps > 0  # the rule was exercised

@@ -33,33 +33,18 @@ from numpy.typing import NDArray
 
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.actions import SPEED_CHANGES_MPS, action_index
+from explaindrive.env.actions import (
+    MAX_BRAKE_MPS,
+    SPEED_CHANGES_MPS,
+    action_index,
+    braking_distances,
+)
 
-MAX_BRAKE_MPS = 3  # [m/s per step] the strongest action
 LEADER_BRAKE_MPS = 9.0  # [m/s per step] how hard a real leader may brake (SUMO emergency decel)
 MARGIN_M = 2.0  # [m] gap kept at standstill
 VIRTUAL_TOL_M = 0.5  # [m] a leader this close to a stop line is the virtual leader
 HARDEST_BRAKE = action_index(-MAX_BRAKE_MPS)
 _CHANGES = np.asarray(SPEED_CHANGES_MPS, dtype=np.float64)
-
-
-def braking_distances(
-    speed_mps: NDArray[np.floating], brake_mps: float = MAX_BRAKE_MPS
-) -> NDArray[np.float64]:
-    """Distances [m] covered after this step when braking by ``brake_mps`` per 1 s step.
-
-    SUMO moves a car by its new speed each step, so from ``v`` the car covers
-    (v - b) + (v - 2b) + ... (the positive terms) while braking to a standstill:
-    with n = ceil(v / b) - 1 terms that is n v - b n (n + 1) / 2.
-    """
-    v = np.maximum(np.asarray(speed_mps, dtype=np.float64), 0.0)
-    n = np.maximum(np.ceil(v / brake_mps) - 1.0, 0.0)
-    return n * v - brake_mps * n * (n + 1.0) / 2.0
-
-
-def braking_distance(speed_mps: float, brake_mps: float = MAX_BRAKE_MPS) -> float:
-    """:func:`braking_distances` of one speed."""
-    return float(braking_distances(np.asarray(speed_mps), brake_mps))
 
 
 def _stopping_need(v_new: NDArray[np.float64]) -> NDArray[np.float64]:

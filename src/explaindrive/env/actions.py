@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import numpy as np
+from numpy.typing import NDArray
+
 SPEED_CHANGES_MPS: tuple[int, ...] = (-3, -2, -1, 0, 1, 2, 3)  # [m/s] per step
 N_ACTIONS = len(SPEED_CHANGES_MPS)
 STEP_LENGTH_S = 1.0  # [s] decision step = SUMO step
 IDLE_ACTION = SPEED_CHANGES_MPS.index(0)
+MAX_BRAKE_MPS = -min(SPEED_CHANGES_MPS)  # [m/s per step] the strongest braking action
 
 
 def speed_change(action: object) -> int:
@@ -37,3 +41,22 @@ def action_index(change_mps: int) -> int:
 def next_speed(v_mps: float, action: int) -> float:
     """Ego speed after applying ``action`` for one step, clipped at 0."""
     return max(0.0, v_mps + speed_change(action))
+
+
+def braking_distances(
+    speed_mps: NDArray[np.floating], brake_mps: float = MAX_BRAKE_MPS
+) -> NDArray[np.float64]:
+    """Distances [m] covered after this step when braking by ``brake_mps`` per 1 s step.
+
+    SUMO moves a car by its new speed each step, so from ``v`` the car covers
+    (v - b) + (v - 2b) + ... (the positive terms) while braking to a standstill:
+    with n = ceil(v / b) - 1 terms that is n v - b n (n + 1) / 2.
+    """
+    v = np.maximum(np.asarray(speed_mps, dtype=np.float64), 0.0)
+    n = np.maximum(np.ceil(v / brake_mps) - 1.0, 0.0)
+    return n * v - brake_mps * n * (n + 1.0) / 2.0
+
+
+def braking_distance(speed_mps: float, brake_mps: float = MAX_BRAKE_MPS) -> float:
+    """:func:`braking_distances` of one speed."""
+    return float(braking_distances(np.asarray(speed_mps), brake_mps))

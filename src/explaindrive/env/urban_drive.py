@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from explaindrive.cache import cache_dir as user_cache_dir
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.actions import N_ACTIONS, STEP_LENGTH_S, speed_change
+from explaindrive.env.actions import N_ACTIONS, STEP_LENGTH_S, braking_distance, speed_change
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.reward import (
@@ -37,7 +37,7 @@ from explaindrive.env.reward import (
     time_to_collision,
 )
 from explaindrive.sim.connection import SumoConnection
-from explaindrive.sim.pedestrians import PedestrianSource
+from explaindrive.sim.pedestrians import KerbYield, PedestrianSource
 from explaindrive.sim.route import RouteCrossing, RouteGeometry, load_route_geometry
 from explaindrive.sim.scenario.files import (
     BASELINE_EGO_TYPES,
@@ -57,6 +57,7 @@ _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
+KERB_MARGIN_M = 2.0  # [m] pedestrians let the ego pass if braking hardest would stop it closer
 _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
 _HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
 
@@ -117,6 +118,7 @@ class _Episode:
     occupied: dict[str, bool] = field(default_factory=dict)
     done: bool = False
     pedestrians: PedestrianSource | None = None
+    kerb: KerbYield = field(default_factory=KerbYield)
 
 
 class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
@@ -168,6 +170,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._leader_len: dict[str, float] = {}
         self._tls_link: dict[str, int] = {}  # traffic light -> index of the ego's link
         self._ego_min_gap_m = 0.0  # SUMO reports leader gaps minus the ego's minGap
+        self._ego_length_m = 0.0
         self._last_obs = np.zeros(S.STATE_DIM, dtype=np.float32)
 
     # ------------------------------------------------------------------ public API
@@ -287,6 +290,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
                 api.vehicle.setSpeed(EGO_ID, v_new)
             if ep.pedestrians is not None:
                 ep.pedestrians.step(api, ep.steps * STEP_LENGTH_S)
+            v_next = v_new if self.config.ego_model == "agent" else ep.speed_mps
+            reach = v_next + braking_distance(v_next) + KERB_MARGIN_M if v_next > 0.0 else 0.0
+            ep.kerb.update(api, self.geometry.crossings, ep.pos_m, self._ego_length_m, reach)
             api.simulationStep()
         except BaseException:
             self.close()
@@ -469,6 +475,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             )
         api.vehicle.setLaneChangeMode(EGO_ID, 0)
         self._ego_min_gap_m = float(api.vehicle.getMinGap(EGO_ID))
+        self._ego_length_m = float(api.vehicle.getLength(EGO_ID))
         if model == "agent":
             api.vehicle.setSpeedMode(EGO_ID, 0)  # no car-following, light or right-of-way checks
             api.vehicle.setSpeed(EGO_ID, 0.0)
@@ -514,15 +521,16 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
 
         At a signalized crossing pedestrians waiting on the kerb wait for their own
         green, and once the ego is on the crossing (``on_it``) those on the kerb wait for
-        it, so then only pedestrians already on the crossing count.
+        it, so then only pedestrians already on the crossing count. At a zebra, those
+        waiting for the ego (:class:`~explaindrive.sim.pedestrians.KerbYield`) do not.
         """
         if self._persons(crossing.crossing_edge):
             return True, True
         if crossing.signalized or on_it:
             return False, False
-        person = self._conn.api.person
+        person, ep = self._conn.api.person, self._episode()
         entering = any(
-            person.getNextEdge(pid) == crossing.crossing_edge
+            person.getNextEdge(pid) == crossing.crossing_edge and not ep.kerb.holds(pid)
             for wa in crossing.walkingareas
             for pid in self._persons(wa)
         )

@@ -1,4 +1,4 @@
-"""Pedestrian demand, generated from Python so that it survives SUMO state loading.
+"""Pedestrians: their demand, and the rule that keeps them off a crossing the ego is on.
 
 SUMO does not restore person flows from a saved state, so the environment adds
 pedestrians itself: Poisson arrivals per flow, drawn from a generator seeded
@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from explaindrive.sim.route import RouteCrossing
 from explaindrive.sim.scenario.layout import PEDESTRIAN_FLOWS, PedestrianFlow
 
 
@@ -54,3 +55,77 @@ class PedestrianSource:
             api.person.appendWalkingStage(pid, [flow.from_edge, flow.to_edge], flow.arrival_pos_m)
             self._next += 1
             self._count += 1
+
+
+class KerbYield:
+    """Pedestrians at a zebra wait on the kerb for a car that can no longer stop before the
+    crossing or is already on it.
+
+    SUMO's pedestrians step onto a crossing where they have priority whatever the
+    approaching cars do. Traffic codes also bind pedestrians: none may step out in front of
+    a vehicle so close that it cannot yield (e.g. the US Uniform Vehicle Code 11-502(b)).
+    This class applies that rule to the ego: each step, the pedestrians about to step from
+    a walking area onto an unsignalized crossing stand still while the ego is on the
+    crossing or would need more than the distance left to stand still before its stop line;
+    they walk on at their own speed once it no longer holds.
+    """
+
+    def __init__(self) -> None:
+        self._held: dict[str, float] = {}  # person -> its walking speed before the hold [m/s]
+
+    def holds(self, person_id: str) -> bool:
+        """Whether the person is waiting for the ego."""
+        return person_id in self._held
+
+    def update(
+        self,
+        api: Any,
+        crossings: tuple[RouteCrossing, ...],
+        front_m: float,
+        length_m: float,
+        reach_m: float,
+    ) -> None:
+        """Hold or release the pedestrians at the ego's crossings.
+
+        Args:
+            api: the running simulation (libsumo or traci).
+            crossings: the crossings over the ego's route.
+            front_m: route position of the ego's front [m].
+            length_m: the ego's length [m].
+            reach_m: how far the ego's front travels before it can stand still [m]; 0 for a
+                car that stands still.
+        """
+        wanted = set()
+        for crossing in crossings:
+            if not crossing.signalized and _blocks(crossing, front_m, length_m, reach_m):
+                wanted.update(_entering(api, crossing))
+        person = api.person
+        for pid in wanted.difference(self._held):
+            self._held[pid] = float(person.getMaxSpeed(pid))
+            person.setSpeed(pid, 0.0)
+        released = [pid for pid in self._held if pid not in wanted]
+        if released:
+            present = set(person.getIDList())
+            for pid in released:
+                speed = self._held.pop(pid)
+                if pid in present:
+                    person.setSpeed(pid, speed)
+
+
+def _blocks(crossing: RouteCrossing, front_m: float, length_m: float, reach_m: float) -> bool:
+    """The ego is on the crossing, or approaches it and cannot stand still before it."""
+    if front_m - length_m >= crossing.end_m:
+        return False
+    ahead = crossing.stop_line_m - front_m
+    return ahead < 0.0 or ahead < reach_m
+
+
+def _entering(api: Any, crossing: RouteCrossing) -> list[str]:
+    """The pedestrians on the crossing's walking areas whose next edge is the crossing."""
+    person = api.person
+    return [
+        pid
+        for wa in crossing.walkingareas
+        for pid in api.edge.getLastStepPersonIDs(wa)
+        if person.getNextEdge(pid) == crossing.crossing_edge
+    ]
