@@ -37,7 +37,9 @@ def _write(out: Path | None, data: dict[str, Any]) -> None:
 
 
 def intents_command(
-    data: Annotated[Path, typer.Option("--data", help="CSV text,label[,kind].")] = DEFAULT_COMMANDS,
+    data: Annotated[
+        Path, typer.Option("--data", help="CSV text,label[,kind][,split].")
+    ] = DEFAULT_COMMANDS,
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
