@@ -156,6 +156,3 @@ def test_config_rejects_unknown_keys(tmp_path) -> None:  # type: ignore[no-untyp
     assert swapped.embedded.encoder_runtime == "torch" and swapped.embedded.encoder_threads == 1
     with pytest.raises(ValueError, match="unknown encoder runtime 'tf'"):
         config.with_runtime("tf")
-    assert config.with_encoder("minilm") is config
-    with pytest.raises(ValueError, match="unknown sentence encoder 'bert'"):
-        config.with_encoder("bert")

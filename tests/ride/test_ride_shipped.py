@@ -100,14 +100,3 @@ def test_openai_backend_that_times_out_falls_back(tmp_path: Path) -> None:
     assert session.records[-1].command == "fast"
     assert session.counts.fallbacks >= 1
     assert len(session.records) == 12
-
-
-def test_an_unknown_encoder_is_refused_before_the_ride(tmp_path: Path) -> None:
-    from typer.testing import CliRunner
-
-    from explaindrive.cli.main import app
-
-    res = CliRunner().invoke(
-        app, ["ride", "--encoder", "bert", "--no-live", "--out", str(tmp_path)]
-    )
-    assert res.exit_code == 2 and "unknown sentence encoder 'bert'" in res.output

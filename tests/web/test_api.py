@@ -138,8 +138,11 @@ def test_a_ride_through_the_api(client):
         res = client.post("/api/ride/answer", json={"yes": True})
         assert res.status_code == 200 and res.json() == {"id": 1, "answer": "yes"}
         fast = wait_for(ws.receive_json, lambda m: m["type"] == "frame" and m["command"] == "fast")
-        assert fast["t"] <= t_confirm + 2  # applied at the next step
-        assert any(e["type"] == "confirmed" and e["to"] == "fast" for e in fast["passenger"])
+        confirmed = next(
+            e for e in fast["passenger"] if e["type"] == "confirmed" and e["to"] == "fast"
+        )
+        # applied at the step that took the answer (the ride runs on while the test waits)
+        assert t_confirm <= confirmed["t"] <= fast["t"] <= confirmed["t"] + 1
 
         assert client.post("/api/ride/resume").status_code == 409
         assert client.post("/api/ride/pause").json()["state"] == "paused"
@@ -264,9 +267,7 @@ def test_a_ride_that_cannot_start():
         client.post("/api/ride/reset")
 
 
-def test_real_stack_checks_backend_and_encoder() -> None:
+def test_real_stack_checks_the_backend() -> None:
     with pytest.raises(ValueError, match="unknown language backend"):
         RealStack("gpt9")
-    with pytest.raises(ValueError, match="unknown sentence encoder 'bert'"):
-        RealStack("embedded", "bert")
-    assert RealStack("embedded", "minilm").encoder == "minilm"  # models load on the first ride
+    assert RealStack("openai").backend == "openai"  # models load on the first ride

@@ -20,12 +20,6 @@ def test_unknown_backend_exits_before_serving() -> None:
     assert "unknown language backend 'gpt'" in res.output
 
 
-def test_unknown_encoder_exits_before_serving() -> None:
-    res = runner.invoke(app, ["serve", "--encoder", "bert"])
-    assert res.exit_code == 2
-    assert "unknown sentence encoder 'bert'" in res.output
-
-
 def test_the_served_names_reach_the_app(monkeypatch: pytest.MonkeyPatch) -> None:
     import uvicorn
 

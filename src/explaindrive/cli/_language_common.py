@@ -17,7 +17,6 @@ err_console = Console(stderr=True)
 
 BACKEND_HELP = "Language backend: embedded (offline, default) or openai."
 CONFIG_HELP = "YAML language config (see docs/language.md)."
-ENCODER_HELP = "LLM-1 sentence encoder of the embedded backend: minilm (the only one)."
 
 
 def load_config(path: Path | None) -> LanguageConfig:

@@ -24,9 +24,7 @@ from rich.console import Console
 from rich.live import Live
 
 from explaindrive.cli._errors import print_error
-from explaindrive.cli._language_common import ENCODER_HELP
 from explaindrive.language.config import LanguageConfig
-from explaindrive.language.encoders import DEFAULT_ENCODER
 from explaindrive.redact import redact
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.runner import OutputDirError, prepare_out_dir
@@ -66,7 +64,6 @@ StopWithoutConfirmOption = Annotated[
 BackendOption = Annotated[
     str, typer.Option("--backend", help="Language backend: embedded or openai.")
 ]
-EncoderOption = Annotated[str, typer.Option("--encoder", help=ENCODER_HELP)]
 CooldownOption = Annotated[float, typer.Option("--cooldown", help="Explanation cool-down [s].")]
 # The simulation
 TrafficOption = Annotated[float, typer.Option("--traffic", help="Traffic level (1.0 = 900 veh/h).")]
@@ -87,7 +84,6 @@ def ride(
     interactive: InteractiveOption = False,
     voice: VoiceOption = False,
     backend: BackendOption = "embedded",
-    encoder: EncoderOption = DEFAULT_ENCODER,
     traffic: TrafficOption = 1.0,
     seed: SeedOption = 0,
     gui: GuiOption = False,
@@ -115,7 +111,7 @@ def ride(
             realtime=realtime or interactive,
             gui=gui,
         )
-        language_config = LanguageConfig().with_encoder(encoder)
+        language_config = LanguageConfig()
         lines = _script_lines(script, interactive, max_steps)
         prepare_out_dir(out, force)
     except (ValueError, ScriptError, OutputDirError) as exc:

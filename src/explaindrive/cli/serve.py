@@ -6,9 +6,8 @@ import typer
 from rich.console import Console
 
 from explaindrive.cli._errors import print_error
-from explaindrive.cli._language_common import ENCODER_HELP
 from explaindrive.language.backends import check_backend
-from explaindrive.language.encoders import DEFAULT_ENCODER, check_installed
+from explaindrive.language.encoders import check_installed
 
 console = Console()
 
@@ -21,7 +20,6 @@ def serve(
     backend: str = typer.Option(
         "embedded", "--backend", help="Language backend: embedded or openai."
     ),
-    encoder: str = typer.Option(DEFAULT_ENCODER, "--encoder", help=ENCODER_HELP),
     step_period: float = typer.Option(
         1.0,
         "--step-period",
@@ -43,7 +41,7 @@ def serve(
 
     try:  # before the server starts
         check_backend(backend)
-        check_installed(encoder)
+        check_installed()
     except (FileNotFoundError, ValueError) as exc:
         print_error(console, exc)
         raise typer.Exit(2) from exc
@@ -53,7 +51,7 @@ def serve(
             f"[yellow]warning:[/yellow] binding {host} exposes the ride controls to the network"
         )
     console.print(f"answering Host names: {', '.join(sorted(hosts))}", highlight=False)
-    app = create_app(backend=backend, encoder=encoder, step_period_s=step_period, hosts=hosts)
+    app = create_app(backend=backend, step_period_s=step_period, hosts=hosts)
     console.print(f"passenger page: http://{host}:{port}/  (Ctrl+C to stop)")
     uvicorn.run(app, host=host, port=port, log_level="warning")
 

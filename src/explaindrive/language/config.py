@@ -12,7 +12,6 @@ from explaindrive.config import StrictModel
 from explaindrive.language.encoders import (
     DEFAULT_RUNTIME,
     EncoderRuntime,
-    check_encoder,
     check_runtime,
 )
 
@@ -101,16 +100,6 @@ class LanguageConfig(_Strict):
         """
         embedded = self.embedded.model_copy(update={"encoder_runtime": check_runtime(runtime)})
         return self.model_copy(update={"embedded": embedded})
-
-    def with_encoder(self, encoder: str) -> LanguageConfig:
-        """This config, once ``encoder`` is checked to name the one sentence encoder (the
-        ``--encoder`` option of ``explaindrive ride``).
-
-        Raises:
-            ValueError: for any name but ``minilm``.
-        """
-        check_encoder(encoder)
-        return self
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> LanguageConfig:

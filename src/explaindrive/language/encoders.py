@@ -53,29 +53,10 @@ def minilm_model_dir() -> Path:
     return packaged_model_dir(MINILM)
 
 
-# The ``--encoder`` option of ``explaindrive ride`` and ``explaindrive serve`` takes an
-# encoder name; this is the only one it accepts.
-DEFAULT_ENCODER = ENCODER
-
-
-def check_encoder(name: str) -> str:
-    """``name`` if it names the encoder (:data:`ENCODER`).
+def check_installed() -> None:
+    """Check that the encoder's package and weights are there, without loading them.
 
     Raises:
-        ValueError: for any other name.
-    """
-    if name != ENCODER:
-        raise ValueError(f"unknown sentence encoder {name!r}; the only one is {ENCODER}")
-    return name
-
-
-def check_installed(name: str = ENCODER) -> str:
-    """Return ``name`` if the encoder can be loaded, without loading it.
-
-    Raises:
-        ValueError: for a name other than :data:`ENCODER`.
         FileNotFoundError: if its package is missing.
     """
-    check_encoder(name)
     minilm_model_dir()
-    return name

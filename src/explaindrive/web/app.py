@@ -34,7 +34,6 @@ from starlette.datastructures import UploadFile
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from explaindrive.language.backends import check_backend
-from explaindrive.language.encoders import ENCODER, check_encoder
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.sim.scenario.files import default_scenario
@@ -75,12 +74,10 @@ class RealStack:
 
     Args:
         backend: language backend, ``embedded`` or ``openai``.
-        encoder: LLM-1 sentence encoder of the embedded backend (only ``minilm``).
     """
 
-    def __init__(self, backend: str = "embedded", encoder: str = ENCODER) -> None:
+    def __init__(self, backend: str = "embedded") -> None:
         self.backend = check_backend(backend)
-        self.encoder = check_encoder(encoder)
         self._controller: Any = None
         self._language: Any = None
 
@@ -103,7 +100,6 @@ def create_app(
     session_factory: SessionFactory | None = None,
     *,
     backend: str = "embedded",
-    encoder: str = ENCODER,
     step_period_s: float = 1.0,
     max_upload_bytes: int = MAX_UPLOAD_BYTES,
     max_audio_s: float = MAX_AUDIO_S,
@@ -115,14 +111,13 @@ def create_app(
         session_factory: builds a ride session from its settings; the real stack
             (:class:`RealStack` with ``backend``) when omitted. Tests inject fakes here.
         backend: language backend of the default factory.
-        encoder: LLM-1 sentence encoder of the default factory's embedded backend.
         step_period_s: wall time per 1 s control step [s]; 1.0 rides in real time.
         max_upload_bytes: largest accepted audio upload [B].
         max_audio_s: longest accepted recording, counted while it is decoded [s].
         hosts: the host names the server answers to (``Host`` header); the loopback
             names by default (see :func:`explaindrive.web.guard.served_hosts`).
     """
-    factory = session_factory or RealStack(backend, encoder)
+    factory = session_factory or RealStack(backend)
     scene = load_scene(default_scenario().net_file)
     manager = RideManager(factory, scene, step_period_s=step_period_s)
 
