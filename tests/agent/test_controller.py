@@ -12,19 +12,14 @@ from explaindrive.agent.checkpoint import CheckpointError, load_policy, save_pol
 from explaindrive.agent.controller import MergedController, QPolicy, shipped_policy_path
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.commands import Command
+from tests import helpers
 
 OBS = np.array([0, 5.0, 13.9, 200.0, 0.0, 200.0, 0, 200.0], dtype=np.float32)
 
 
 def constant_policy(tmp_path: Path, name: str, action: int) -> Path:
     """A network whose Q-values ignore the input and peak at ``action``."""
-    net = DuelingQNetwork((4,))
-    with torch.no_grad():
-        for p in net.parameters():
-            p.zero_()
-        net.advantage.bias[action] = 1.0
-    path, _ = save_policy(tmp_path / f"{name}.pt", net, {"name": name})
-    return path
+    return helpers.constant_policy(tmp_path / f"{name}.pt", action, {"name": name})
 
 
 def test_policy_round_trip_and_raw_observations(tmp_path: Path) -> None:

@@ -15,7 +15,6 @@ def test_braking_distance(v, brake, expected):
     assert braking_distance(v, brake) == pytest.approx(expected)
 
 
-
 def test_braking_distances_of_a_batch_match_the_step_sum() -> None:
     speeds = np.array([13.0, 6.0, 3.0, 0.0, 9.5, 1.0])
     # 10+7+4+1, 3, 0, 0, 6.5+3.5+0.5, 0

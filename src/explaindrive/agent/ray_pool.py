@@ -64,6 +64,24 @@ class RayRolloutActor:
         return os.getpid()
 
 
+def start_ray(address: str | None, num_cpus: int) -> bool:
+    """Connect to the cluster at ``address``, or start a local Ray of ``num_cpus`` CPUs,
+    unless Ray is running in this process already; returns whether it was started here
+    (the caller then shuts it down).
+
+    Raises:
+        ConfigError: naming the extra, if Ray is not installed.
+    """
+    ray = require_ray()
+    if ray.is_initialized():
+        return False
+    if address:
+        ray.init(address=address, include_dashboard=False, log_to_driver=False)
+    else:
+        ray.init(num_cpus=num_cpus, include_dashboard=False, log_to_driver=False)
+    return True
+
+
 class RayPool:
     """``num_workers`` rollout actors on a local Ray or on the cluster at ``address``."""
 
@@ -76,13 +94,7 @@ class RayPool:
     ) -> None:
         self.ray = ray = require_ray()
         self.num_workers = num_workers
-        self._owns_ray = not ray.is_initialized()
-        if self._owns_ray:
-            if address:
-                ray.init(address=address, include_dashboard=False, log_to_driver=False)
-            else:
-                cpus = max(num_workers, os.cpu_count() or 1)
-                ray.init(num_cpus=cpus, include_dashboard=False, log_to_driver=False)
+        self._owns_ray = start_ray(address, max(num_workers, os.cpu_count() or 1))
         actor = ray.remote(num_cpus=1, max_restarts=-1, max_task_retries=0)(RayRolloutActor)
         self.actors = [actor.remote(config, env_factory, i) for i in range(num_workers)]
         self._refs: list[Any] = []

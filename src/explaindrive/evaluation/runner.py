@@ -199,15 +199,10 @@ def _run_pool(
 def _run_ray(
     specs: list[EpisodeSpec], workers: int, address: str | None, progress: Progress | None
 ) -> list[EpisodeRecord]:
-    import ray
+    from explaindrive.agent.ray_pool import require_ray, start_ray
 
-    started = False
-    if not ray.is_initialized():
-        if address:
-            ray.init(address=address, include_dashboard=False, log_to_driver=False)
-        else:
-            ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
-        started = True
+    ray = require_ray()
+    started = start_ray(address, workers)
     try:
         task = ray.remote(num_cpus=1, max_retries=0)(_ray_episode)
         refs = [task.remote(spec) for spec in specs]

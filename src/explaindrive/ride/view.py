@@ -6,6 +6,7 @@ from rich.panel import Panel
 from rich.table import Table
 
 from explaindrive.env.state import SENSOR_RANGE_M, LightState
+from explaindrive.ride.events import EventType
 from explaindrive.ride.session import RideSession, StepRecord
 
 
@@ -39,7 +40,7 @@ def render(session: RideSession, rec: StepRecord | None) -> Panel:
             e
             for r in reversed(session.records)
             for e in reversed(r.passenger)
-            if e["type"] == "line"
+            if e["type"] == EventType.LINE
         ),
         None,
     )

@@ -6,11 +6,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from explaindrive.sim.scenario.layout import (
-    MAX_TRAFFIC_LEVEL,
-    SEED_LIMIT,
-    validate_traffic_level,
-)
+from explaindrive.config import Seed, TrafficLevel
 
 MAX_TEXT_CHARS = 300  # a spoken request is a sentence or two
 MAX_RIDE_STEPS = 1800  # [s] half an hour of driving
@@ -30,15 +26,10 @@ class StartRequest(_Strict):
         max_steps: longest ride [s].
     """
 
-    traffic_level: float = Field(default=1.0, gt=0, le=MAX_TRAFFIC_LEVEL)
-    seed: int = Field(default=0, ge=0, lt=SEED_LIMIT)
+    traffic_level: TrafficLevel = 1.0
+    seed: Seed = 0
     command: Literal["fast", "comfort", "stop"] = "comfort"
     max_steps: int = Field(default=600, gt=0, le=MAX_RIDE_STEPS)
-
-    @field_validator("traffic_level")
-    @classmethod
-    def _known_level(cls, value: float) -> float:
-        return validate_traffic_level(value)
 
 
 class SayRequest(_Strict):
