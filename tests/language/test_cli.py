@@ -7,10 +7,10 @@ import json
 import typer
 from typer.testing import CliRunner
 
-from explaindrive.cli import eval_cmd, eval_language, explain, interpret, transcribe
+from explaindrive.cli import explain, interpret, score, transcribe
 
 app = typer.Typer()
-for mod in (interpret, explain, transcribe, eval_cmd, eval_language):
+for mod in (interpret, explain, transcribe, score):
     mod.register(app)
 runner = CliRunner()
 

@@ -29,8 +29,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "explaindrive.cli.interpret",
     "explaindrive.cli.explain",
     "explaindrive.cli.transcribe",
-    "explaindrive.cli.eval_cmd",
-    "explaindrive.cli.eval_language",
+    "explaindrive.cli.score",
     "explaindrive.cli.serve",
 )
 

@@ -16,7 +16,6 @@ from explaindrive.cli._language_common import (
     fail,
     load_config,
 )
-from explaindrive.cli.eval_cmd import score_app
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
     TEST_CSV,
@@ -25,6 +24,12 @@ from explaindrive.language.datasets import (
     load_decisions,
 )
 
+score_app = typer.Typer(
+    name="score",
+    help="Score the language layer on labelled data.",
+    no_args_is_help=True,
+    add_completion=False,
+)
 DEFAULT_COMMANDS = data_path(TEST_CSV)
 DEFAULT_DECISIONS = data_path(DECISIONS_JSONL)
 
@@ -106,6 +111,7 @@ def decisions_command(
 
 
 def register(app: typer.Typer) -> None:
-    """Add ``intents`` and ``decisions`` to the ``score`` group."""
+    """Mount the ``score`` group, with ``intents`` and ``decisions``, on the root command."""
     score_app.command("intents")(intents_command)
     score_app.command("decisions")(decisions_command)
+    app.add_typer(score_app, name="score")
