@@ -133,6 +133,7 @@ class Trainer:
         self.lost_rounds = 0  # rounds lost to a worker that died (Ray restarts it)
         self.clean_streak = 0  # consecutive finished episodes without override or violation
         self.recent_returns: deque[float] = deque(maxlen=config.moving_average_window)
+        self.source_commit = git_commit()  # the code this run (or its resume) started from
 
         if resume:
             self._restore()
@@ -302,7 +303,7 @@ class Trainer:
             "final_mean_return": (
                 float(np.mean(self.recent_returns)) if self.recent_returns else None
             ),
-            "git_commit": git_commit(),
+            "git_commit": self.source_commit,
             "torch_version": torch.__version__,
             "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
             "evaluation": None,
