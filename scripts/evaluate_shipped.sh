@@ -29,5 +29,6 @@ for p in fast comfort; do
   run "${p}_shielded_stops" "$p" --seeds "$SEEDS" --stop-schedule "$STOPS"
 done
 run krauss_large krauss --seeds "$SEEDS"
+run krauss_175 krauss --seeds "$SEEDS" --traffic 1.75
 run idm_large idm --seeds "$SEEDS"
 run merged_large merged --seeds "$SEEDS" --commands "fast:0-90,stop:90-110,comfort:110-"
