@@ -116,3 +116,14 @@ def test_standing_at_the_line_when_it_turns_yellow_is_no_dilemma() -> None:
     standing = obs(v=0, d_lead=0.7, dv=0, d_tl=0.7, tls=1)
     assert runtime_mask(standing).tolist() == [True] * 4 + [False] * 3
     assert training_mask(standing).tolist() == [True] * 4 + [False] * 3
+
+
+def test_dilemma_braking_is_left_to_the_rewards_unless_configured() -> None:
+    # yellow 17.9 m ahead at 13 m/s: braking hardest covers 10 + 7 + 4 + 1 = 22 m > 17.9
+    dilemma = obs(v=13, lim=13.9, d_lead=17.9, dv=13, d_tl=17.9, tls=1)
+    allowed = [action_index(c) for c in (-3, -2, -1, 0)]  # +1 would exceed the limit
+    assert np.flatnonzero(training_mask(dilemma)).tolist() == allowed
+    assert np.flatnonzero(training_mask(dilemma, dilemma_braking=False)).tolist() == [
+        action_index(0)
+    ]
+    assert np.flatnonzero(runtime_mask(dilemma)).tolist() == [action_index(0)]

@@ -68,3 +68,24 @@ def test_worker_errors_name_the_worker() -> None:
     with pytest.raises(ValueError, match="num_workers must be > 0"):
         make_pool(CONFIG, FACTORY, 0)
     assert isinstance(make_pool(CONFIG, FACTORY, 1), InProcessPool)
+
+
+class _YellowAhead(FakeDriveEnv):
+    """Always a yellow light 17.9 m ahead at 13 m/s: the dilemma zone (braking hardest
+    covers 10 + 7 + 4 + 1 = 22 m)."""
+
+    def _obs(self) -> np.ndarray:
+        return np.array([0, 13.0, 13.9, 17.9, 13.0, 17.9, 1.0, 200.0], dtype=np.float32)
+
+
+@pytest.mark.parametrize(("dilemma_braking", "allowed"), [(True, 4), (False, 1)])
+def test_the_learning_mask_follows_the_dilemma_braking_setting(
+    dilemma_braking: bool, allowed: int
+) -> None:
+    config = CONFIG.replace(dilemma_braking=dilemma_braking)
+    worker = RolloutWorker(config, functools.partial(_YellowAhead, max_steps=5), 0)
+    rollout = worker.collect(CollectRequest(steps=5, epsilon=0.5, weights=_weights(), start=0))
+    assert rollout.transitions
+    for *_, mask, next_mask in rollout.transitions:
+        # -3..0 m/s when braking is left to the rewards; keeping the speed only otherwise
+        assert mask.sum() == next_mask.sum() == allowed and mask[3]

@@ -131,6 +131,10 @@ class TrainConfig(ConfigModel):
     """Value the Q-values of unsafe actions are pushed down to (``safe_learning``)."""
     unsafe_loss_weight: NonNegativeFloat = 1.0
     """Weight of that loss next to the TD loss."""
+    dilemma_braking: bool = True
+    """Whether the safety mask of learning leaves braking in a yellow light's dilemma zone
+    (where even the hardest braking cannot stop before the line) to the rewards; ``False``
+    marks it unsafe, as the run-time shield does (``safe_learning``)."""
     shielded_fraction: Fraction = 1.0
     """Share of the episodes (the first ones) that act through the safety mask; the rest act
     on the bare network's choice, still learning from the masks (``safe_learning``)."""

@@ -240,7 +240,7 @@ class RolloutWorker:
             return _Running(
                 plan, summary, NStepQueue(c.n_step, c.gamma),
                 np.random.default_rng([c.seed, 3, plan.index]), obs,
-                training_mask(obs), runtime_mask(obs),
+                training_mask(obs, c.dilemma_braking), runtime_mask(obs),
             )  # fmt: skip
         raise RuntimeError(
             f"worker {self.worker_id}: episode {plan.index} failed to start "
@@ -255,7 +255,7 @@ class RolloutWorker:
         action = int(D3QNLearner.explore(q, epsilon, ep.rng, act_mask)[0])
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         next_obs = np.asarray(next_obs, dtype=np.float32)
-        next_mask = training_mask(next_obs)
+        next_mask = training_mask(next_obs, self.config.dilemma_braking)
         done = bool(terminated or truncated)
         out.transitions += ep.queue.push(
             ep.obs, action, float(reward), ep.mask, next_obs, next_mask, bool(terminated), done

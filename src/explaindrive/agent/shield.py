@@ -121,10 +121,13 @@ def _with_fallback(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
     return mask
 
 
-def training_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
-    """The safety mask learning uses: dilemma braking allowed, STOP must make progress,
-    and the hardest braking where nothing is safe (every row allows an action)."""
-    return _with_fallback(safe_action_mask(obs, dilemma_braking=True, stop_progress=True))
+def training_mask(obs: NDArray[np.floating], dilemma_braking: bool = True) -> NDArray[np.bool_]:
+    """The safety mask learning uses: dilemma braking allowed unless ``dilemma_braking`` is
+    false, STOP must make progress, and the hardest braking where nothing is safe (every row
+    allows an action)."""
+    return _with_fallback(
+        safe_action_mask(obs, dilemma_braking=dilemma_braking, stop_progress=True)
+    )
 
 
 def runtime_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
