@@ -212,8 +212,12 @@ def seeds_section(paths: Sequence[Path]) -> str:
     lines = ["", "## Training seeds", ""]
     for path in paths:
         body = path.read_text(encoding="utf-8").strip().splitlines()
-        title = body[0].lstrip("# ") if body and body[0].startswith("#") else ""
-        lines += [f"### {path.parent.name}: {title}", "", *body[1:], ""]
+        title = ""
+        if body and body[0].startswith("#"):
+            title, body = body[0].lstrip("# ").removeprefix("Training seeds: "), body[1:]
+        while body and not body[0].strip():
+            body = body[1:]
+        lines += [f"### {path.parent.name}: {title}", "", *body, ""]
     return "\n".join(lines)
 
 
