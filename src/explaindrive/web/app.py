@@ -83,8 +83,6 @@ class RealStack:
 
     def __call__(self, config: RideConfig) -> RideSession:
         """Build a ride session with ``config`` (its backend is replaced by this one's)."""
-        from dataclasses import replace
-
         from explaindrive.agent.controller import MergedController
         from explaindrive.language.config import LanguageConfig
         from explaindrive.language.stack import make_language_stack
@@ -93,7 +91,7 @@ class RealStack:
             self._controller = MergedController.from_package()
         if self._language is None:
             self._language = make_language_stack(self.backend, LanguageConfig()).load()
-        return RideSession(replace(config, backend=self.backend), self._controller, self._language)
+        return RideSession(config.replace(backend=self.backend), self._controller, self._language)
 
 
 def create_app(
