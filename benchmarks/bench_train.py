@@ -87,6 +87,11 @@ def trainer_rate(config: TrainConfig, out: Path, use_ray: bool = False) -> tuple
     train(config, out, use_ray=use_ray)
     with (out / "episodes.csv").open(newline="") as f:
         rows = [r for r in csv.DictReader(f) if int(r["env_steps"]) > config.learning_starts]
+    if len(rows) < 2:
+        raise SystemExit(
+            f"fewer than 2 episodes ended after the first {config.learning_starts} env steps "
+            "(no updates before them): raise --episodes"
+        )
     first, last = rows[0], rows[-1]
     steps = int(last["env_steps"]) - int(first["env_steps"])
     return steps / (float(last["wall_time_s"]) - float(first["wall_time_s"])), steps
