@@ -1,0 +1,84 @@
+"""Print the steps that led to each violation of one episode of a bare network.
+
+    python scripts/trace_violations.py src/explaindrive/agent/policies/fast.pt \
+        --seed 44 --traffic 0.75
+
+For every collision, red-light run or pedestrian-yield violation it prints the last
+``--before`` steps: the time and the ego's route position, the observation, the
+network's speed change, and the actions that the learning mask (the shipped recipe's)
+and the run-time shield allow (one digit per action, -3 ... +3 m/s).
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections import deque
+from pathlib import Path
+
+from explaindrive.agent.controller import MergedController, QPolicy
+from explaindrive.agent.shield import runtime_mask, training_mask
+from explaindrive.commands import Command
+from explaindrive.env.actions import speed_change
+from explaindrive.env.config import EnvConfig
+from explaindrive.env.state import STATE_NAMES
+from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.evaluation.spec import parse_stop_schedule, stops_to_schedule
+
+VIOLATIONS = ("collision", "red_light_run", "ped_violation")
+
+
+def _bits(mask: object) -> str:
+    return "".join("1" if allowed else "0" for allowed in mask)  # type: ignore[attr-defined]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("policy", type=Path, help="a policy .pt file")
+    parser.add_argument("--seed", type=int, required=True)
+    parser.add_argument("--traffic", type=float, default=1.0)
+    parser.add_argument("--command", default=None, help="fast or comfort (default: the card's)")
+    parser.add_argument("--stop-schedule", default=None, help="e.g. 60-75,150-165 [s]")
+    parser.add_argument("--before", type=int, default=6, help="steps shown before each event")
+    args = parser.parse_args()
+
+    agent = QPolicy.load(args.policy)
+    command = Command.parse(args.command or agent.card.get("mode", "fast"))
+    driver = MergedController(agent, agent, command, use_shield=False)
+    schedule = (
+        stops_to_schedule(command.label, parse_stop_schedule(args.stop_schedule))
+        if args.stop_schedule
+        else ()
+    )
+    env = UrbanDriveEnv(config=EnvConfig(traffic_level=args.traffic))
+    obs, _ = env.reset(
+        seed=args.seed,
+        options={"command": command.label, "traffic_level": args.traffic,
+                 "command_schedule": [list(item) for item in schedule]},
+    )  # fmt: skip
+    print("time pos_m", *STATE_NAMES, "change", "learning", "shield", sep="\t")
+    recent: deque[str] = deque(maxlen=args.before)
+    done, events, steps = False, 0, 0
+    try:
+        while not done:
+            driver.set_command(env.command)
+            action = int(driver.act(obs))
+            cells = [f"{env.time_s:.0f}s {env._episode().pos_m:.1f}"]
+            cells += [f"{x:.1f}" for x in obs]
+            cells += [f"{speed_change(action):+d}", _bits(training_mask(obs)),
+                      _bits(runtime_mask(obs))]  # fmt: skip
+            recent.append("\t".join(cells))
+            obs, _, terminated, truncated, info = env.step(action)
+            steps += 1
+            done = terminated or truncated
+            happened = [name for name in VIOLATIONS if info.get(name)]
+            if happened:
+                events += 1
+                print(f"-- {', '.join(happened)} at {info['time_s']:.0f} s")
+                print(*recent, sep="\n")
+    finally:
+        env.close()
+    print(f"{events} violation step(s) in {steps} steps")
+
+
+if __name__ == "__main__":
+    main()
