@@ -36,12 +36,12 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import (
     MAX_BRAKE_MPS,
     SPEED_CHANGES_MPS,
+    STOP_MARGIN_M,
     action_index,
     braking_distances,
 )
 
 LEADER_BRAKE_MPS = 9.0  # [m/s per step] how hard a real leader may brake (SUMO emergency decel)
-MARGIN_M = 2.0  # [m] gap kept at standstill
 VIRTUAL_TOL_M = 0.5  # [m] a leader this close to a stop line is the virtual leader
 HARDEST_BRAKE = action_index(-MAX_BRAKE_MPS)
 _CHANGES = np.asarray(SPEED_CHANGES_MPS, dtype=np.float64)
@@ -51,7 +51,7 @@ def _stopping_need(v_new: NDArray[np.float64]) -> NDArray[np.float64]:
     """[m] from the ego's front to where it stands still after this step and braking, plus
     the margin; 0 for a car that stands still after this step (it moves no further)."""
     moving = v_new > 0.0
-    return np.where(moving, v_new + braking_distances(v_new) + MARGIN_M, 0.0)
+    return np.where(moving, v_new + braking_distances(v_new) + STOP_MARGIN_M, 0.0)
 
 
 def steps_to_stop(speed_mps: NDArray[np.floating] | float) -> NDArray[np.float64]:

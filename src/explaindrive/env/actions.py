@@ -10,6 +10,7 @@ N_ACTIONS = len(SPEED_CHANGES_MPS)
 STEP_LENGTH_S = 1.0  # [s] decision step = SUMO step
 IDLE_ACTION = SPEED_CHANGES_MPS.index(0)
 MAX_BRAKE_MPS = -min(SPEED_CHANGES_MPS)  # [m/s per step] the strongest braking action
+STOP_MARGIN_M = 2.0  # [m] the gap a car braking hardest keeps before where it must stand
 
 
 def speed_change(action: object) -> int:

@@ -25,7 +25,13 @@ from numpy.typing import NDArray
 from explaindrive.cache import cache_dir as user_cache_dir
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.actions import N_ACTIONS, STEP_LENGTH_S, braking_distance, speed_change
+from explaindrive.env.actions import (
+    N_ACTIONS,
+    STEP_LENGTH_S,
+    STOP_MARGIN_M,
+    braking_distance,
+    speed_change,
+)
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.reward import (
@@ -57,7 +63,6 @@ _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
-KERB_MARGIN_M = 2.0  # [m] pedestrians let the ego pass if braking hardest would stop it closer
 _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
 _HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
 
@@ -291,7 +296,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             if ep.pedestrians is not None:
                 ep.pedestrians.step(api, ep.steps * STEP_LENGTH_S)
             v_next = v_new if self.config.ego_model == "agent" else ep.speed_mps
-            reach = v_next + braking_distance(v_next) + KERB_MARGIN_M if v_next > 0.0 else 0.0
+            reach = v_next + braking_distance(v_next) + STOP_MARGIN_M if v_next > 0.0 else 0.0
             ep.kerb.update(api, self.geometry.crossings, ep.pos_m, self._ego_length_m, reach)
             api.simulationStep()
         except BaseException:
