@@ -30,10 +30,18 @@ class DiesOnce(FakeDriveEnv):
 
     def reset(self, *, seed=None, options=None):  # type: ignore[no-untyped-def]
         self.resets += 1
-        if self.resets == 3 and not self.marker.exists():
-            self.marker.touch()
+        if self.resets == 3 and self._first_to_die():
             os._exit(1)
         return super().reset(seed=seed, options=options)
+
+    def _first_to_die(self) -> bool:
+        """Create the marker atomically: both workers reach their third reset at about the
+        same time, and only one of them may die."""
+        try:
+            os.close(os.open(self.marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+        except FileExistsError:
+            return False
+        return True
 
 
 def rows(out: Path) -> list[dict[str, str]]:
