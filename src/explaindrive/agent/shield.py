@@ -36,22 +36,15 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import (
     MAX_BRAKE_MPS,
     SPEED_CHANGES_MPS,
-    STOP_MARGIN_M,
     action_index,
     braking_distances,
+    stopping_needs,
 )
 
 LEADER_BRAKE_MPS = 9.0  # [m/s per step] how hard a real leader may brake (SUMO emergency decel)
 VIRTUAL_TOL_M = 0.5  # [m] a leader this close to a stop line is the virtual leader
 HARDEST_BRAKE = action_index(-MAX_BRAKE_MPS)
 _CHANGES = np.asarray(SPEED_CHANGES_MPS, dtype=np.float64)
-
-
-def _stopping_need(v_new: NDArray[np.float64]) -> NDArray[np.float64]:
-    """[m] from the ego's front to where it stands still after this step and braking, plus
-    the margin; 0 for a car that stands still after this step (it moves no further)."""
-    moving = v_new > 0.0
-    return np.where(moving, v_new + braking_distances(v_new) + STOP_MARGIN_M, 0.0)
 
 
 def steps_to_stop(speed_mps: NDArray[np.floating] | float) -> NDArray[np.float64]:
@@ -82,7 +75,7 @@ def safe_action_mask(
     x = x.reshape(-1, S.STATE_DIM)
     v = x[:, S.V_EGO : S.V_EGO + 1]  # (B, 1)
     v_new = np.maximum(v + _CHANGES, 0.0)  # (B, 7)
-    need = _stopping_need(v_new)
+    need = stopping_needs(v_new)
 
     over_limit = v_new > x[:, S.V_LIM : S.V_LIM + 1]
     safe = ~(over_limit & (v_new > v - MAX_BRAKE_MPS + 1e-9))
@@ -93,7 +86,7 @@ def safe_action_mask(
     d_tl = x[:, S.D_TL : S.D_TL + 1]
     tls = np.rint(x[:, S.TLS : S.TLS + 1])
     light = (d_tl < S.SENSOR_RANGE_M) & (tls != 0)
-    must_go = light & (tls == 1) & (_stopping_need(np.maximum(v - MAX_BRAKE_MPS, 0.0)) > d_tl)
+    must_go = light & (tls == 1) & (stopping_needs(np.maximum(v - MAX_BRAKE_MPS, 0.0)) > d_tl)
     safe &= ~(light & ~must_go & (need > d_tl))
     if not dilemma_braking:
         safe &= ~(must_go & (v_new < v))

@@ -61,3 +61,22 @@ def braking_distances(
 def braking_distance(speed_mps: float, brake_mps: float = MAX_BRAKE_MPS) -> float:
     """:func:`braking_distances` of one speed."""
     return float(braking_distances(np.asarray(speed_mps), brake_mps))
+
+
+def stopping_needs(v_new: NDArray[np.floating]) -> NDArray[np.float64]:
+    """[m] a car needs ahead of its front to stand still, braking hardest after a step that
+    leaves it at ``v_new``: that step, the braking and :data:`STOP_MARGIN_M`; 0 for a car
+    that stands still after the step (it moves no further)."""
+    v = np.asarray(v_new, dtype=np.float64)
+    return np.where(v > 0.0, v + braking_distances(v) + STOP_MARGIN_M, 0.0)
+
+
+def stopping_need(v_new: float) -> float:
+    """:func:`stopping_needs` of one speed."""
+    return float(stopping_needs(np.asarray(v_new)))
+
+
+def can_stop_before(speed_mps: float, distance_m: float) -> bool:
+    """Whether a car at ``speed_mps`` can still stand :data:`STOP_MARGIN_M` before a line
+    ``distance_m`` ahead by braking hardest from now on (outside a yellow's dilemma zone)."""
+    return stopping_need(max(speed_mps - MAX_BRAKE_MPS, 0.0)) <= distance_m

@@ -28,11 +28,11 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import (
     N_ACTIONS,
     STEP_LENGTH_S,
-    STOP_MARGIN_M,
-    braking_distance,
     speed_change,
+    stopping_need,
 )
 from explaindrive.env.config import EnvConfig
+from explaindrive.env.lights import AmberDecision
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.reward import (
     STOP_REASON_GAP_M,
@@ -124,6 +124,7 @@ class _Episode:
     done: bool = False
     pedestrians: PedestrianSource | None = None
     kerb: KerbYield = field(default_factory=KerbYield)
+    amber: AmberDecision = field(default_factory=AmberDecision)
 
 
 class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
@@ -296,7 +297,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             if ep.pedestrians is not None:
                 ep.pedestrians.step(api, ep.steps * STEP_LENGTH_S)
             v_next = v_new if self.config.ego_model == "agent" else ep.speed_mps
-            reach = v_next + braking_distance(v_next) + STOP_MARGIN_M if v_next > 0.0 else 0.0
+            reach = stopping_need(v_next)
             ep.kerb.update(api, self.geometry.crossings, ep.pos_m, self._ego_length_m, reach)
             api.simulationStep()
         except BaseException:
@@ -555,8 +556,11 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         rng = S.SENSOR_RANGE_M
         real = self._real_leader(api, ego)
         leader = real
-        d_tl, tls = self._next_light(api, ep.pos_m)
-        if d_tl < rng and tls is not S.LightState.GREEN and (leader is None or d_tl < leader.gap_m):
+        d_tl, tls, light_id = self._next_light(api, ep.pos_m)
+        stops = light_id is not None and ep.amber.is_leader(light_id, tls, v, d_tl)
+        if light_id is None:
+            ep.amber.clear()
+        if stops and (leader is None or d_tl < leader.gap_m):
             leader = _Leader(max(d_tl, 0.0), 0.0, 0.0, True)
         d_cross = self._next_busy_crossing(ep.pos_m)
         if d_cross < rng and (leader is None or d_cross < leader.gap_m):
@@ -591,11 +595,11 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             length = self._leader_len[lid] = float(api.vehicle.getLength(lid))
         return _Leader(max(gap, 0.0), float(api.vehicle.getSpeed(lid)), length, False)
 
-    def _next_light(self, api: Any, pos: float) -> tuple[float, S.LightState]:
-        """Distance to the next light's stop line and its colour (range and green when
-        none is in range); records the colours the ego's lights show."""
+    def _next_light(self, api: Any, pos: float) -> tuple[float, S.LightState, str | None]:
+        """Distance to the next light's stop line, its colour and its id (range, green and
+        ``None`` when none is in range); records the colours the ego's lights show."""
         ep = self._episode()
-        d_tl, tls = S.SENSOR_RANGE_M, S.LightState.GREEN
+        d_tl, tls, light_id = S.SENSOR_RANGE_M, S.LightState.GREEN, None
         ep.light_state = {}
         for light in self.geometry.lights:
             ahead = light.stop_line_m - pos
@@ -607,9 +611,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             )
             ep.light_state[light.tls_id] = colour
             if ahead < S.SENSOR_RANGE_M:
-                d_tl, tls = ahead, colour
+                d_tl, tls, light_id = ahead, colour, light.tls_id
             break
-        return d_tl, tls
+        return d_tl, tls, light_id
 
     def _next_busy_crossing(self, pos: float) -> float:
         """Distance to the nearest crossing a pedestrian is on or entering (range if none);

@@ -1,0 +1,48 @@
+"""When a light ahead is a virtual leader: the decision at yellow.
+
+The paper places a zero-length virtual leader at the stop line of a red or yellow light,
+after Treiber and Kesting's traffic-light model, in which a driver who sees the light turn
+yellow decides once whether to stop: only a driver who can still stop before the line
+treats it as a standing vehicle. One who cannot (the dilemma zone) drives through, since
+braking would leave the car on the junction at red. :class:`AmberDecision` makes that
+decision when the ego first sees a light yellow, with the ego's hardest braking
+(:func:`~explaindrive.env.actions.can_stop_before`, the rule the run-time shield uses),
+and keeps it while that light stays yellow. A red light is always a virtual leader.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from explaindrive.env.actions import can_stop_before
+from explaindrive.env.state import LightState
+
+
+@dataclass(slots=True)
+class AmberDecision:
+    """The ego's decision at the yellow of the light ahead, kept until that yellow ends."""
+
+    light_id: str | None = None
+    """The light the decision is about (``None``: no yellow decided)."""
+    stops: bool = True
+    """Whether the ego stops for that light's yellow."""
+
+    def is_leader(self, light_id: str, colour: LightState, speed_mps: float, d_tl: float) -> bool:
+        """Whether the stop line of light ``light_id`` ahead is a virtual leader this step.
+
+        Args:
+            light_id: the light ahead within sensor range.
+            colour: its colour this step.
+            speed_mps: the ego's speed.
+            d_tl: [m] from the ego's front to its stop line.
+        """
+        if colour is not LightState.YELLOW:
+            self.light_id = None
+            return colour is LightState.RED
+        if self.light_id != light_id:
+            self.light_id, self.stops = light_id, can_stop_before(speed_mps, d_tl)
+        return self.stops
+
+    def clear(self) -> None:
+        """No light in range: the next yellow is decided afresh."""
+        self.light_id = None
