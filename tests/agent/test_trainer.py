@@ -76,13 +76,21 @@ def test_tiny_run_writes_every_output(tmp_path: Path) -> None:
     assert len(events.Scalars("losses/td_loss")) == 7  # updates 10, 20, ..., 70
 
 
-def test_resume_continues_where_the_run_stopped(tmp_path: Path) -> None:
+def test_resume_continues_where_the_run_stopped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr("explaindrive.agent.trainer.git_commit", lambda: "a" * 40)
     train(tiny(episodes=6), tmp_path, env_factory=FACTORY)
     with pytest.raises(CheckpointError, match="already holds a training run"):
         train(tiny(episodes=6), tmp_path, env_factory=FACTORY)
+    monkeypatch.setattr("explaindrive.agent.trainer.git_commit", lambda: "b" * 40)
     result = train(tiny(episodes=10), tmp_path, env_factory=FACTORY, resume=True)
     assert (result.episodes, result.env_steps, result.updates) == (10, 200, 75)
     assert [int(r["episode"]) for r in rows(tmp_path)] == list(range(10))
+    # the card names the commit the run started from and every commit it was resumed at
+    card = QPolicy.load(result.policy_path).card
+    assert card["git_commit"] == "a" * 40
+    assert card["git_commits"] == ["a" * 40, "b" * 40]
 
 
 def test_resume_refuses_a_mismatched_or_corrupt_checkpoint(tmp_path: Path) -> None:

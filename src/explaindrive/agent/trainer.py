@@ -133,7 +133,7 @@ class Trainer:
         self.lost_rounds = 0  # rounds lost to a worker that died (Ray restarts it)
         self.clean_streak = 0  # consecutive finished episodes without override or violation
         self.recent_returns: deque[float] = deque(maxlen=config.moving_average_window)
-        self.source_commit = git_commit()  # the code this run (or its resume) started from
+        self.source_commits = [git_commit()]  # the code of the start and of each resume
 
         if resume:
             self._restore()
@@ -156,6 +156,7 @@ class Trainer:
             "lost_rounds": self.lost_rounds,
             "clean_streak": self.clean_streak,
             "recent_returns": list(self.recent_returns),
+            "source_commits": self.source_commits,
             "rng": self.rng.bit_generator.state,
             "torch_rng": torch.get_rng_state(),
         }
@@ -179,6 +180,9 @@ class Trainer:
         self.lost_rounds = int(t.get("lost_rounds", 0))
         self.clean_streak = int(t.get("clean_streak", 0))
         self.recent_returns.extend(float(r) for r in t["recent_returns"])
+        # a checkpoint written before commits were kept does not know where the run started
+        earlier = list(t.get("source_commits", [None]))
+        self.source_commits = earlier + [c for c in self.source_commits if c != earlier[-1]]
         self.rng.bit_generator.state = t["rng"]
         torch.set_rng_state(t["torch_rng"])
         if not truncate_csv(self.csv_path, self.episodes_done) and self.episodes_done:
@@ -303,7 +307,8 @@ class Trainer:
             "final_mean_return": (
                 float(np.mean(self.recent_returns)) if self.recent_returns else None
             ),
-            "git_commit": self.source_commit,
+            "git_commit": self.source_commits[0],
+            "git_commits": self.source_commits,
             "torch_version": torch.__version__,
             "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
             "evaluation": None,
