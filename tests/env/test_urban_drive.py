@@ -100,6 +100,36 @@ def test_virtual_leader_on_red_and_for_pedestrians(make_env):
     assert seen_red and seen_ped
 
 
+class _IgnoresLights:
+    """Follows real leaders like :class:`CautiousDriver` but drives through every light."""
+
+    def __call__(self, obs):
+        if abs(obs[S.D_LEAD] - obs[S.D_TL]) <= 0.5:  # the light's virtual leader
+            obs = obs.copy()
+            obs[S.D_LEAD] = S.SENSOR_RANGE_M
+        return CautiousDriver()(obs)
+
+
+def test_a_yellow_is_a_leader_only_where_the_car_could_stop_for_it(make_env):
+    # Traffic 0.5, a driver that holds its speed through lights: on seed 2 the light turns
+    # yellow 74.9 m ahead at 13 m/s (braking to 10 m/s and on needs 10 + 12 + 2 = 24 m, so
+    # the car stops for it); on seed 8, 16.9 m ahead at 13 m/s (it needs 24 m > 16.9 m: the
+    # dilemma zone, driven through without a leader at the line).
+    env = make_env(traffic_level=0.5)
+    firsts = {}
+    for seed in (2, 8):
+        obs_seq, _, _, _ = run_episode(env, _IgnoresLights(), seed=seed)
+        yellow = [i for i, o in enumerate(obs_seq) if o[S.TLS] == 1 and o[S.D_TL] < 200]
+        first = obs_seq[yellow[0]]
+        firsts[seed] = (float(first[S.V_EGO]), float(first[S.D_TL]), float(first[S.D_LEAD]))
+        for i in yellow:  # the decision holds while the light stays yellow
+            leads = obs_seq[i][S.D_LEAD] == pytest.approx(obs_seq[i][S.D_TL], abs=1e-3)
+            assert leads == (seed == 2)
+    assert firsts[2] == pytest.approx((13.0, 74.9, 74.9), abs=0.05)
+    v, d_tl, d_lead = firsts[8]
+    assert (v, d_tl) == pytest.approx((13.0, 16.9), abs=0.05) and d_lead > d_tl
+
+
 def test_cautious_driver_breaks_no_rule(make_env):
     env = make_env()
     for seed in range(4):
