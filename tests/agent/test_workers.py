@@ -3,6 +3,12 @@
 from __future__ import annotations
 
 import functools
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -89,3 +95,51 @@ def test_the_learning_mask_follows_the_dilemma_braking_setting(
     for *_, mask, next_mask in rollout.transitions:
         # -3..0 m/s when braking is left to the rewards; keeping the speed only otherwise
         assert mask.sum() == next_mask.sum() == allowed and mask[3]
+
+
+_KILLED_PARENT = """
+import functools, os, signal, sys
+sys.path.insert(0, {root!r})
+from explaindrive.agent.config import preset
+from explaindrive.agent.rollout import CollectRequest
+from explaindrive.agent.workers import ProcessPool
+from tests.agent.fake_drive_env import FakeDriveEnv
+
+if __name__ == "__main__":
+    config = preset("safe").replace(hidden_sizes=[8], num_envs=2, episodes=10)
+    factory = functools.partial(FakeDriveEnv, max_steps=100_000, step_delay_s=0.01)
+    pool = ProcessPool(config, factory, 2)
+    pool.submit([CollectRequest(100_000, 0.5, None, start) for start in (0, 1)])
+    print(*(proc.pid for proc in pool._procs), flush=True)  # a 1,000 s round each
+    os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+def _running(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has ended
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="parent-death signal: Linux")
+def test_workers_end_with_a_killed_parent(tmp_path: Path) -> None:
+    root = str(Path(__file__).resolve().parents[2])
+    script = tmp_path / "parent.py"
+    script.write_text(_KILLED_PARENT.format(root=root), encoding="utf-8")
+    # the workers inherit the pipe, so read the line and wait for the parent alone
+    with subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                          text=True, cwd=root) as parent:  # fmt: skip
+        assert parent.stdout is not None
+        pids = [int(p) for p in parent.stdout.readline().split()]
+        assert parent.wait(timeout=60) == -signal.SIGKILL
+        assert len(pids) == 2
+        parent.stdout.close()
+    deadline = time.monotonic() + 10.0
+    while any(map(_running, pids)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    alive = [pid for pid in pids if _running(pid)]
+    for pid in alive:
+        os.kill(pid, signal.SIGKILL)
+    assert not alive, "rollout workers outlived their killed parent"

@@ -11,9 +11,12 @@ with an error naming the worker.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import logging
 import multiprocessing as mp
 import os
+import signal
+import sys
 import traceback
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -77,8 +80,25 @@ class InProcessPool:
             worker.close()
 
 
-def _serve(conn: Connection, config: TrainConfig, factory: EnvFactory, worker_id: int) -> None:
+_PR_SET_PDEATHSIG = 1  # prctl option: the signal this process gets when its parent dies
+
+
+def _end_with_parent(parent_pid: int) -> None:
+    """On Linux, have the kernel end this process when ``parent_pid`` dies (a killed trainer
+    must not leave workers playing their round); elsewhere the next pipe read ends it."""
+    if not sys.platform.startswith("linux"):
+        return
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    if os.getppid() != parent_pid:  # the parent died before the signal was armed
+        os._exit(1)
+
+
+def _serve(
+    conn: Connection, config: TrainConfig, factory: EnvFactory, worker_id: int, parent_pid: int
+) -> None:
     """Process loop: build the worker, then answer ``collect`` until ``close``."""
+    _end_with_parent(parent_pid)
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     worker = None
     try:
@@ -103,6 +123,10 @@ def _serve(conn: Connection, config: TrainConfig, factory: EnvFactory, worker_id
 class ProcessPool:
     """One worker per local process (``spawn``: no inherited torch threads or SUMO state).
 
+    On Linux a worker ends when the thread that built the pool ends, so build it in a
+    thread that outlives it (the trainer builds it in the caller's thread); a trainer
+    killed by any signal leaves no worker behind.
+
     Raises:
         RuntimeError: naming the worker, if one fails to start or to play its round.
     """
@@ -115,7 +139,7 @@ class ProcessPool:
         self._closed = False
         for i in range(num_workers):
             parent, child = ctx.Pipe()
-            proc = ctx.Process(target=_serve, args=(child, config, env_factory, i),
+            proc = ctx.Process(target=_serve, args=(child, config, env_factory, i, os.getpid()),
                                name=f"explaindrive-worker-{i}", daemon=True)  # fmt: skip
             proc.start()
             child.close()
