@@ -39,6 +39,7 @@ from explaindrive.env.actions import (
     action_index,
     braking_distances,
     stopping_needs,
+    stops_before,
 )
 
 LEADER_BRAKE_MPS = 9.0  # [m/s per step] how hard a real leader may brake (SUMO emergency decel)
@@ -86,7 +87,7 @@ def safe_action_mask(
     d_tl = x[:, S.D_TL : S.D_TL + 1]
     tls = np.rint(x[:, S.TLS : S.TLS + 1])
     light = (d_tl < S.SENSOR_RANGE_M) & (tls != 0)
-    must_go = light & (tls == 1) & (stopping_needs(np.maximum(v - MAX_BRAKE_MPS, 0.0)) > d_tl)
+    must_go = light & (tls == 1) & ~stops_before(v, d_tl)
     safe &= ~(light & ~must_go & (need > d_tl))
     if not dilemma_braking:
         safe &= ~(must_go & (v_new < v))

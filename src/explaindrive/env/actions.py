@@ -76,7 +76,15 @@ def stopping_need(v_new: float) -> float:
     return float(stopping_needs(np.asarray(v_new)))
 
 
-def can_stop_before(speed_mps: float, distance_m: float) -> bool:
-    """Whether a car at ``speed_mps`` can still stand :data:`STOP_MARGIN_M` before a line
+def stops_before(
+    speed_mps: NDArray[np.floating], distance_m: NDArray[np.floating]
+) -> NDArray[np.bool_]:
+    """Whether cars at ``speed_mps`` can still stand :data:`STOP_MARGIN_M` before lines
     ``distance_m`` ahead by braking hardest from now on (outside a yellow's dilemma zone)."""
-    return stopping_need(max(speed_mps - MAX_BRAKE_MPS, 0.0)) <= distance_m
+    v = np.asarray(speed_mps, dtype=np.float64)
+    return stopping_needs(np.maximum(v - MAX_BRAKE_MPS, 0.0)) <= np.asarray(distance_m)
+
+
+def can_stop_before(speed_mps: float, distance_m: float) -> bool:
+    """:func:`stops_before` of one car and line."""
+    return bool(stops_before(np.asarray(speed_mps), np.asarray(distance_m)))
