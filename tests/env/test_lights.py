@@ -35,5 +35,5 @@ def test_each_yellow_is_decided_afresh() -> None:
     assert amber.is_leader("B", YELLOW, 11.0, 80.0)  # the next light
     amber.is_leader("B", GREEN, 11.0, 40.0)
     assert not amber.is_leader("B", YELLOW, 11.0, 13.9)  # its next yellow
-    amber.clear()  # no light in range
+    amber.is_leader(None, GREEN, 11.0, 200.0)  # no light in range
     assert amber.is_leader("B", YELLOW, 11.0, 60.0)

@@ -27,11 +27,14 @@ class AmberDecision:
     stops: bool = True
     """Whether the ego stops for that light's yellow."""
 
-    def is_leader(self, light_id: str, colour: LightState, speed_mps: float, d_tl: float) -> bool:
+    def is_leader(
+        self, light_id: str | None, colour: LightState, speed_mps: float, d_tl: float
+    ) -> bool:
         """Whether the stop line of light ``light_id`` ahead is a virtual leader this step.
 
         Args:
-            light_id: the light ahead within sensor range.
+            light_id: the light ahead within sensor range (``None``: none in range; its
+                colour is then green, and the next yellow is decided afresh).
             colour: its colour this step.
             speed_mps: the ego's speed.
             d_tl: [m] from the ego's front to its stop line.
@@ -42,7 +45,3 @@ class AmberDecision:
         if self.light_id != light_id:
             self.light_id, self.stops = light_id, can_stop_before(speed_mps, d_tl)
         return self.stops
-
-    def clear(self) -> None:
-        """No light in range: the next yellow is decided afresh."""
-        self.light_id = None

@@ -557,10 +557,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         real = self._real_leader(api, ego)
         leader = real
         d_tl, tls, light_id = self._next_light(api, ep.pos_m)
-        stops = light_id is not None and ep.amber.is_leader(light_id, tls, v, d_tl)
-        if light_id is None:
-            ep.amber.clear()
-        if stops and (leader is None or d_tl < leader.gap_m):
+        if ep.amber.is_leader(light_id, tls, v, d_tl) and (leader is None or d_tl < leader.gap_m):
             leader = _Leader(max(d_tl, 0.0), 0.0, 0.0, True)
         d_cross = self._next_busy_crossing(ep.pos_m)
         if d_cross < rng and (leader is None or d_cross < leader.gap_m):
