@@ -40,6 +40,7 @@ def test_paper_preset_holds_the_paper_values() -> None:
         0.99,
     )
     assert c.episodes == 11_000
+    assert c.yellow_leader == "always"  # the paper's virtual leader at every yellow
 
 
 def test_safe_preset_is_shorter_and_learns_the_shield() -> None:
@@ -48,6 +49,7 @@ def test_safe_preset_is_shorter_and_learns_the_shield() -> None:
     assert c.eps_decay_steps < PAPER.eps_decay_steps
     assert c.safe_learning and c.n_step == 3 and c.stop_when_safe == 200
     assert not PAPER.safe_learning and PAPER.n_step == 1 and PAPER.stop_when_safe is None
+    assert c.yellow_leader == "decided"
 
 
 def test_unknown_preset_and_key_are_rejected() -> None:
@@ -115,6 +117,10 @@ def test_unknown_keys_and_bad_values_are_reported_together() -> None:
         ({"save_replay": 1}, "save_replay: Input should be a valid boolean, got 1"),
         ({"save_replay": "yes"}, "save_replay: Input should be a valid boolean, got 'yes'"),
         ({"mode": 1}, "mode: Input should be a valid string, got 1"),
+        (
+            {"yellow_leader": "sometimes"},
+            "yellow_leader: must be one of decided, always, got 'sometimes'",
+        ),
         ({"batch_size": 128, "buffer_size": 64}, "batch_size (128) exceeds buffer_size (64)"),
     ],
 )

@@ -80,6 +80,22 @@ def test_stop_reaches_the_agent_as_cmd_2(tmp_path: Path) -> None:
     assert ctrl.act(OBS) == 0
 
 
+def test_the_controller_drives_in_its_networks_yellow_rule(tmp_path: Path) -> None:
+    def policy(name: str, rule: str | None) -> Path:
+        config = {} if rule is None else {"yellow_leader": rule}
+        return helpers.constant_policy(tmp_path / f"{name}.pt", 1, {"config": config})
+
+    # a card written before the field existed: the default rule
+    assert MergedController.from_files(policy("a", None), policy("b", "decided")).yellow_leader == (
+        "decided"
+    )
+    paper = MergedController.from_files(policy("c", "always"), policy("d", "always"))
+    assert paper.yellow_leader == "always"
+    mixed = MergedController.from_files(policy("e", "always"), policy("f", "decided"))
+    with pytest.raises(CheckpointError, match="different yellow-light rules"):
+        _ = mixed.yellow_leader
+
+
 def test_shipped_policy_paths() -> None:
     assert shipped_policy_path("fast").name == "fast.pt"
     assert shipped_policy_path("comfort").parent.name == "policies"

@@ -143,3 +143,14 @@ def test_workers_end_with_a_killed_parent(tmp_path: Path) -> None:
     for pid in alive:
         os.kill(pid, signal.SIGKILL)
     assert not alive, "rollout workers outlived their killed parent"
+
+
+@pytest.mark.parametrize(("name", "rule"), [("paper", "always"), ("safe", "decided")])
+def test_the_real_env_factory_builds_the_presets_yellow_rule(name: str, rule: str) -> None:
+    from explaindrive.agent.rollout import default_env_factory
+
+    env = default_env_factory(preset(name).replace(max_episode_steps=50))()
+    try:
+        assert (env.config.yellow_leader, env.config.max_steps) == (rule, 50)  # type: ignore[attr-defined]
+    finally:
+        env.close()

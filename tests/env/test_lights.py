@@ -37,3 +37,11 @@ def test_each_yellow_is_decided_afresh() -> None:
     assert not amber.is_leader("B", YELLOW, 11.0, 13.9)  # its next yellow
     amber.is_leader(None, GREEN, 11.0, 200.0)  # no light in range
     assert amber.is_leader("B", YELLOW, 11.0, 60.0)
+
+
+def test_with_the_papers_rule_every_yellow_is_a_leader() -> None:
+    amber = AmberDecision(always=True)
+    assert amber.is_leader("A", YELLOW, 11.0, 13.9)  # the dilemma zone too
+    assert amber.is_leader("A", YELLOW, 8.0, 5.9)
+    assert amber.is_leader("A", RED, 5.0, 0.9)
+    assert not amber.is_leader("A", GREEN, 5.0, 0.9)

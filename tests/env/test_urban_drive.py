@@ -130,6 +130,17 @@ def test_a_yellow_is_a_leader_only_where_the_car_could_stop_for_it(make_env):
     assert (v, d_tl) == pytest.approx((13.0, 16.9), abs=0.05) and d_lead > d_tl
 
 
+def test_the_papers_rule_makes_the_dilemma_zone_yellow_a_leader(make_env):
+    # The yellow of seed 8 above, 16.9 m ahead at 13 m/s, with yellow_leader="always".
+    env = make_env(traffic_level=0.5, yellow_leader="always")
+    obs_seq, _, _, _ = run_episode(env, _IgnoresLights(), seed=8)
+    yellow = [i for i, o in enumerate(obs_seq) if o[S.TLS] == 1 and o[S.D_TL] < 200]
+    first = obs_seq[yellow[0]]
+    assert (first[S.V_EGO], first[S.D_TL]) == pytest.approx((13.0, 16.9), abs=0.05)
+    for i in yellow:
+        assert obs_seq[i][S.D_LEAD] == pytest.approx(obs_seq[i][S.D_TL], abs=1e-3)
+
+
 def test_cautious_driver_breaks_no_rule(make_env):
     env = make_env()
     for seed in range(4):

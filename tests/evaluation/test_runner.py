@@ -140,3 +140,27 @@ def test_report_document(tmp_path: Path, policies: tuple[Path, Path]) -> None:
     assert f"{rec.result.steps} steps, mean speed {rec.result.mean_speed_mps:.3f} m/s" in md
     assert "![merged_profile](figures/merged_profile.png)" in md
     assert (tmp_path / "docs" / "figures" / "merged_profile.png").is_file()
+
+
+class _BuiltError(Exception):
+    """Raised by the probe env once run_episode has built it."""
+
+
+def test_a_network_is_evaluated_with_the_yellow_rule_it_was_trained_with(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rules: list[str] = []
+
+    class ProbeEnv:
+        def __init__(self, config):  # type: ignore[no-untyped-def]
+            rules.append(config.yellow_leader)
+            raise _BuiltError
+
+    monkeypatch.setattr("explaindrive.env.urban_drive.UrbanDriveEnv", ProbeEnv)
+    for rule in ("always", "decided"):
+        card = {"mode": "fast", "config": {"yellow_leader": rule}}
+        path = constant_policy(tmp_path / f"{rule}.pt", action_index(0), card)
+        spec = plan_run(parse_policy(str(path)), [0], [1.0], max_steps=MAX_STEPS).episodes[0]
+        with pytest.raises(_BuiltError):
+            run_episode(spec)
+    assert rules == ["always", "decided"]

@@ -36,6 +36,7 @@ from explaindrive.config import (
     one_of,
     read_yaml,
 )
+from explaindrive.env.lights import YELLOW_LEADERS
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 TRAIN_MODES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
@@ -131,6 +132,11 @@ class TrainConfig(ConfigModel):
     """Value the Q-values of unsafe actions are pushed down to (``safe_learning``)."""
     unsafe_loss_weight: NonNegativeFloat = 1.0
     """Weight of that loss next to the TD loss."""
+    yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = "decided"
+    """When the environment makes a yellow light's stop line a virtual leader: ``decided``
+    once by whether the car can still stop there, or ``always`` (the paper; see
+    :mod:`explaindrive.env.lights`). A network is evaluated with the rule it was trained
+    with."""
     dilemma_braking: bool = True
     """Whether the safety mask of learning leaves braking in a yellow light's dilemma zone
     (where even the hardest braking cannot stop before the line) to the rewards; ``False``
@@ -190,8 +196,9 @@ class TrainConfig(ConfigModel):
         return Command.parse(self.mode)
 
 
-PAPER = TrainConfig()
-"""The paper's values: 2x128, Adam 1e-3, MSE, 5M replay, batch 64, gamma 0.99, 11,000 episodes."""
+PAPER = TrainConfig(yellow_leader="always")
+"""The paper's values: 2x128, Adam 1e-3, MSE, 5M replay, batch 64, gamma 0.99, 11,000 episodes,
+and its virtual leader at every yellow light."""
 
 SAFE = TrainConfig(
     episodes=1600,

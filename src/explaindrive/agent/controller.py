@@ -17,6 +17,7 @@ import numpy as np
 import torch
 
 from explaindrive.agent.checkpoint import CheckpointError, load_policy
+from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
@@ -68,6 +69,13 @@ class QPolicy:
         """Greedy action of one raw observation."""
         return int(np.argmax(self.q_values(obs)))
 
+    @property
+    def yellow_leader(self) -> str:
+        """The environment's rule for yellow lights the network was trained with (its card's
+        ``config.yellow_leader``; a card without it predates the field: the default)."""
+        rule = self.card.get("config", {}).get("yellow_leader")
+        return str(rule) if rule is not None else TrainConfig.model_fields["yellow_leader"].default
+
 
 class MergedController:
     """Switches between the fast and comfort policies at runtime.
@@ -101,6 +109,22 @@ class MergedController:
         self.last_network_action: int | None = None
         self._stop_steps_left: int | None = None  # under STOP: steps left to a standstill
         self.set_command(command)
+
+    @property
+    def yellow_leader(self) -> str:
+        """The environment's rule for yellow lights both networks were trained with, which
+        the controller must drive in: their observations depend on it.
+
+        Raises:
+            CheckpointError: if the two networks were trained with different rules.
+        """
+        rules = {p.yellow_leader for p in self.policies.values()}
+        if len(rules) > 1:
+            raise CheckpointError(
+                "the fast and comfort networks were trained with different yellow-light "
+                f"rules ({', '.join(sorted(rules))}); merge networks trained alike"
+            )
+        return rules.pop()
 
     @classmethod
     def from_files(

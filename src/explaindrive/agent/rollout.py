@@ -46,18 +46,20 @@ def reseed(seed: int, attempt: int) -> int:
     return int(np.random.default_rng([seed, attempt, 7]).integers(0, SEED_LIMIT - 1))
 
 
-def make_urban_drive_env(max_steps: int | None = None) -> gym.Env:
+def make_urban_drive_env(max_steps: int | None = None, yellow_leader: str = "decided") -> gym.Env:
     """The project's SUMO environment (imported lazily: each worker builds its own)."""
     from explaindrive.env.config import EnvConfig
     from explaindrive.env.urban_drive import UrbanDriveEnv
 
-    env_config = EnvConfig() if max_steps is None else EnvConfig(max_steps=max_steps)
-    return UrbanDriveEnv(config=env_config)
+    config = EnvConfig(yellow_leader=yellow_leader)
+    return UrbanDriveEnv(
+        config=config if max_steps is None else config.replace(max_steps=max_steps)
+    )
 
 
 def default_env_factory(config: TrainConfig) -> EnvFactory:
     """Picklable factory of the real environment for ``config``."""
-    return functools.partial(make_urban_drive_env, config.max_episode_steps)
+    return functools.partial(make_urban_drive_env, config.max_episode_steps, config.yellow_leader)
 
 
 Transition = tuple[np.ndarray, int, float, np.ndarray, bool, float, np.ndarray, np.ndarray]

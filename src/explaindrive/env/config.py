@@ -8,6 +8,7 @@ from typing import Annotated, Any
 from pydantic import NonNegativeInt, PositiveInt
 
 from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
+from explaindrive.env.lights import YELLOW_LEADERS
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
@@ -27,6 +28,9 @@ class EnvConfig(ConfigModel):
             baseline that drives the ego itself with its safety checks on: ``"krauss"``
             or ``"idm"``. Baselines ignore the action; a STOP command makes SUMO brake to
             a standstill (at most 3 m/s^2) and hold it.
+        yellow_leader: when a yellow light's stop line is a virtual leader: ``"decided"``
+            once, when the ego first sees the yellow, by whether it can still stop there
+            (:mod:`explaindrive.env.lights`), or ``"always"``, as in the paper.
     """
 
     config_name = "env config"
@@ -39,6 +43,7 @@ class EnvConfig(ConfigModel):
     cache_dir: TextPath | None = None
     insert_timeout_s: PositiveInt = 60
     ego_model: Annotated[str, one_of(EGO_MODELS)] = "agent"
+    yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = "decided"
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any]) -> EnvConfig:

@@ -8,6 +8,9 @@ braking would leave the car on the junction at red. :class:`AmberDecision` makes
 decision when the ego first sees a light yellow, with the ego's hardest braking
 (:func:`~explaindrive.env.actions.can_stop_before`, the rule the run-time shield uses),
 and keeps it while that light stays yellow. A red light is always a virtual leader.
+
+``YELLOW_LEADERS`` names the two rules an environment can use: ``decided`` (the above, the
+default) and ``always``, the paper's own leader at every yellow.
 """
 
 from __future__ import annotations
@@ -16,6 +19,10 @@ from dataclasses import dataclass
 
 from explaindrive.env.actions import can_stop_before
 from explaindrive.env.state import LightState
+
+YELLOW_LEADERS: tuple[str, ...] = ("decided", "always")
+"""When a yellow light is a virtual leader: ``decided`` once by :class:`AmberDecision`, or
+``always`` (the paper)."""
 
 
 @dataclass(slots=True)
@@ -26,6 +33,8 @@ class AmberDecision:
     """The light the decision is about (``None``: no yellow decided)."""
     stops: bool = True
     """Whether the ego stops for that light's yellow."""
+    always: bool = False
+    """Every yellow is a leader (the paper's rule): nothing is decided."""
 
     def is_leader(
         self, light_id: str | None, colour: LightState, speed_mps: float, d_tl: float
@@ -42,6 +51,8 @@ class AmberDecision:
         if colour is not LightState.YELLOW:
             self.light_id = None
             return colour is LightState.RED
+        if self.always:
+            return True
         if self.light_id != light_id:
             self.light_id, self.stops = light_id, can_stop_before(speed_mps, d_tl)
         return self.stops

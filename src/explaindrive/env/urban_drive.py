@@ -231,6 +231,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             schedule=schedule,
             start_pos_m=start_pos,
             pedestrians=PedestrianSource(int(sumo_seed), horizon_s=self.config.max_steps + 1.0),
+            amber=AmberDecision(always=self.config.yellow_leader == "always"),
         )
         self._apply_schedule(0.0)
         self._ep.pos_m = start_pos

@@ -90,6 +90,8 @@ def run_episode(spec: EpisodeSpec) -> EpisodeRecord:
     config = EnvConfig(
         traffic_level=spec.traffic_level, max_steps=spec.max_steps, ego_model=policy.ego_model
     )
+    if driver is not None:  # a network drives in the environment it was trained in
+        config = config.replace(yellow_leader=driver.yellow_leader)
     env = UrbanDriveEnv(config=config)
     metrics = EpisodeMetrics()
     speeds: list[float] = []
