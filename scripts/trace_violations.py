@@ -49,7 +49,9 @@ def main() -> None:
         if args.stop_schedule
         else ()
     )
-    env = UrbanDriveEnv(config=EnvConfig(traffic_level=args.traffic))
+    env = UrbanDriveEnv(
+        config=EnvConfig(traffic_level=args.traffic, yellow_leader=agent.yellow_leader)
+    )
     obs, _ = env.reset(
         seed=args.seed,
         options={"command": command.label, "traffic_level": args.traffic,
@@ -62,7 +64,7 @@ def main() -> None:
         while not done:
             driver.set_command(env.command)
             action = int(driver.act(obs))
-            cells = [f"{env.time_s:.0f}s {env._episode().pos_m:.1f}"]
+            cells = [f"{env.time_s:.0f}s {env.route_pos_m:.1f}"]
             cells += [f"{x:.1f}" for x in obs]
             cells += [f"{speed_change(action):+d}", _bits(training_mask(obs)),
                       _bits(runtime_mask(obs))]  # fmt: skip

@@ -78,6 +78,15 @@ def test_action_changes_speed_by_its_amount(make_env):
     assert speeds == [3.0, 5.0, 4.0, 1.0, 0.0]  # clipped at 0
 
 
+def test_route_position_moves_by_the_distance_driven(make_env):
+    env = make_env(traffic_level=0.5)
+    env.reset(seed=1)
+    start = env.route_pos_m
+    for change in (3, 2):  # 3 then 5 m/s: 8 m in two 1 s steps
+        _, _, _, _, info = env.step(action_index(change))
+    assert env.route_pos_m - start == pytest.approx(info["distance_m"]) == pytest.approx(8.0)
+
+
 def test_virtual_leader_on_red_and_for_pedestrians(make_env):
     env = make_env(traffic_level=0.5)
     seen_red = seen_ped = False

@@ -202,6 +202,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         return float(self._episode().steps) * STEP_LENGTH_S
 
     @property
+    def route_pos_m(self) -> float:
+        """The ego's front along its route [m] (the distances to lights and crossings are
+        measured from it)."""
+        return self._episode().pos_m
+
+    @property
     def sumo(self) -> Any:
         """The running ``libsumo``/``traci`` module, for read-only inspection (e.g. rendering)."""
         return self._conn.api
