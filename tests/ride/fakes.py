@@ -9,6 +9,7 @@ from typing import ClassVar
 import numpy as np
 
 from explaindrive.commands import Command
+from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.env.scripted import CautiousDriver
 from explaindrive.env.state import CMD
 from explaindrive.language.decision import Conflict, Decision, ExplanationDecider, Factor
@@ -22,9 +23,10 @@ from explaindrive.language.summary import StateRecord
 class ScriptedController:
     """The merged-controller interface over the cautious rule-based driver."""
 
-    def __init__(self) -> None:
+    def __init__(self, yellow_leader: str = DEFAULT_YELLOW_LEADER) -> None:
         self.command = Command.FAST
         self.active_agent = Command.FAST
+        self.yellow_leader = yellow_leader
         self.driver = CautiousDriver()
         self.use_shield = False
         self.last_override = False

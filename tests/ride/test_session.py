@@ -180,6 +180,15 @@ def test_a_remote_deadline_must_leave_room_for_the_fallback():
         RideSession(RideConfig(), ScriptedController(), fake_language(remote_deadline_s=1.5))
 
 
+@pytest.mark.parametrize("rule", ["always", "decided"])
+def test_the_ride_drives_in_the_networks_yellow_rule(rule):
+    session = RideSession(RideConfig(), ScriptedController(rule), fake_language())
+    try:
+        assert session.env.config.yellow_leader == rule
+    finally:
+        session.env.close()
+
+
 class OverriddenEveryThirdStep(ScriptedController):
     """Pretends the shield replaced a +3 m/s choice of the network every third step."""
 

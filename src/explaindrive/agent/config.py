@@ -36,7 +36,7 @@ from explaindrive.config import (
     one_of,
     read_yaml,
 )
-from explaindrive.env.lights import YELLOW_LEADERS
+from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 TRAIN_MODES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
@@ -132,7 +132,7 @@ class TrainConfig(ConfigModel):
     """Value the Q-values of unsafe actions are pushed down to (``safe_learning``)."""
     unsafe_loss_weight: NonNegativeFloat = 1.0
     """Weight of that loss next to the TD loss."""
-    yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = "decided"
+    yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = DEFAULT_YELLOW_LEADER
     """When the environment makes a yellow light's stop line a virtual leader: ``decided``
     once by whether the car can still stop there, or ``always`` (the paper; see
     :mod:`explaindrive.env.lights`). A network is evaluated with the rule it was trained

@@ -17,10 +17,10 @@ import numpy as np
 import torch
 
 from explaindrive.agent.checkpoint import CheckpointError, load_policy
-from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
+from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.env.metrics import stop_latency_bound
 from explaindrive.env.state import CMD, STATE_DIM, V_EGO
 
@@ -73,8 +73,7 @@ class QPolicy:
     def yellow_leader(self) -> str:
         """The environment's rule for yellow lights the network was trained with (its card's
         ``config.yellow_leader``; a card without it predates the field: the default)."""
-        rule = self.card.get("config", {}).get("yellow_leader")
-        return str(rule) if rule is not None else TrainConfig.model_fields["yellow_leader"].default
+        return str(self.card.get("config", {}).get("yellow_leader", DEFAULT_YELLOW_LEADER))
 
 
 class MergedController:

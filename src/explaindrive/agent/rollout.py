@@ -30,6 +30,7 @@ from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.schedule import EpisodePlan, plan_episode
 from explaindrive.agent.shield import runtime_mask, training_mask
+from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.sim.scenario.layout import SEED_LIMIT
 
 log = logging.getLogger(__name__)
@@ -46,7 +47,9 @@ def reseed(seed: int, attempt: int) -> int:
     return int(np.random.default_rng([seed, attempt, 7]).integers(0, SEED_LIMIT - 1))
 
 
-def make_urban_drive_env(max_steps: int | None = None, yellow_leader: str = "decided") -> gym.Env:
+def make_urban_drive_env(
+    max_steps: int | None = None, yellow_leader: str = DEFAULT_YELLOW_LEADER
+) -> gym.Env:
     """The project's SUMO environment (imported lazily: each worker builds its own)."""
     from explaindrive.env.config import EnvConfig
     from explaindrive.env.urban_drive import UrbanDriveEnv

@@ -8,7 +8,7 @@ from typing import Annotated, Any
 from pydantic import NonNegativeInt, PositiveInt
 
 from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
-from explaindrive.env.lights import YELLOW_LEADERS
+from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
@@ -43,7 +43,7 @@ class EnvConfig(ConfigModel):
     cache_dir: TextPath | None = None
     insert_timeout_s: PositiveInt = 60
     ego_model: Annotated[str, one_of(EGO_MODELS)] = "agent"
-    yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = "decided"
+    yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = DEFAULT_YELLOW_LEADER
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any]) -> EnvConfig:

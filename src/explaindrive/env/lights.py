@@ -23,6 +23,7 @@ from explaindrive.env.state import LightState
 YELLOW_LEADERS: tuple[str, ...] = ("decided", "always")
 """When a yellow light is a virtual leader: ``decided`` once by :class:`AmberDecision`, or
 ``always`` (the paper)."""
+DEFAULT_YELLOW_LEADER = "decided"
 
 
 @dataclass(slots=True)

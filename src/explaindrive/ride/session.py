@@ -146,6 +146,7 @@ class RideSession:
         self.env = env or UrbanDriveEnv(
             traffic_level=config.traffic_level,
             max_steps=config.max_steps,
+            yellow_leader=controller.yellow_leader,  # the networks' own rule
             render_mode="human" if config.gui else None,
         )
         self.lane = LanguageLane()
