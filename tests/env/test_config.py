@@ -30,7 +30,8 @@ def test_unknown_key_is_named() -> None:
         EnvConfig.from_mapping({"max_step": 10})
     assert str(err.value) == (
         "unknown env config key(s): max_step; known keys: cache_dir, ego_model, "
-        "insert_timeout_s, max_steps, net_file, normalize_obs, traffic_level, warmup_s"
+        "insert_timeout_s, max_steps, net_file, normalize_obs, traffic_level, warmup_s, "
+        "yellow_leader"
     )
     with pytest.raises(ConfigError, match=r"^unknown env config key\(s\): trafic_level; "):
         EnvConfig().replace(trafic_level=0.5)
@@ -51,6 +52,7 @@ def test_unknown_key_is_named() -> None:
             "ego_model: must be one of agent, krauss, idm, got 'wiedemann'",
         ),
         ({"net_file": 3}, "net_file: Input is not a valid path"),
+        ({"yellow_leader": "never"}, "yellow_leader: must be one of decided, always, got 'never'"),
     ],
 )
 def test_bad_settings_are_rejected(settings: dict[str, object], message: str) -> None:
