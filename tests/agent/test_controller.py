@@ -96,6 +96,18 @@ def test_the_controller_drives_in_its_networks_yellow_rule(tmp_path: Path) -> No
         _ = mixed.yellow_leader
 
 
+def test_a_trained_network_replaces_a_shipped_one(tmp_path: Path) -> None:
+    run = tmp_path / "run"  # a training run directory holds its policy.pt
+    run.mkdir()
+    helpers.constant_policy(run / "policy.pt", 6, {"name": "mine"})
+    ctrl = MergedController.from_package(fast=run)
+    assert ctrl.policies[Command.FAST].card == {"name": "mine"}
+    assert ctrl.act(OBS) == 6
+    assert ctrl.policies[Command.COMFORT].card["name"] == "comfort"  # still the shipped one
+    with pytest.raises(CheckpointError, match="not found"):
+        MergedController.from_package(comfort=tmp_path / "missing.pt")
+
+
 def test_shipped_policy_paths() -> None:
     assert shipped_policy_path("fast").name == "fast.pt"
     assert shipped_policy_path("comfort").parent.name == "policies"

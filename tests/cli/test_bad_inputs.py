@@ -53,6 +53,11 @@ def test_ride_out_holding_a_previous_ride(tmp_path: Path) -> None:
     assert (tmp_path / "r1" / "summary.json").read_text() == "{}"
 
 
+def test_ride_with_a_missing_policy(tmp_path: Path) -> None:
+    line = one_error_line(run("ride", "--no-live", "--fast-policy", "runs/x", cwd=tmp_path))
+    assert line == "error: policy file not found: runs/x.pt"
+
+
 def test_ride_script_with_a_missing_audio_file(tmp_path: Path) -> None:
     (tmp_path / "s.yaml").write_text("- {t: 0, say: hurry}\n- {t: 20, audio: stop.wav}\n")
     line = one_error_line(run("ride", "--no-live", "--script", "s.yaml", cwd=tmp_path))

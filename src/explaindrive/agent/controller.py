@@ -133,19 +133,19 @@ class MergedController:
         return cls(QPolicy.load(fast_path), QPolicy.load(comfort_path), use_shield=use_shield)
 
     @classmethod
-    def from_package(cls, use_shield: bool = True) -> MergedController:
-        """Controller over the policies shipped with the package.
+    def from_package(
+        cls,
+        use_shield: bool = True,
+        fast: str | Path | None = None,
+        comfort: str | Path | None = None,
+    ) -> MergedController:
+        """Controller over the policies shipped with the package, or over ``fast`` /
+        ``comfort`` in their place (a policy ``.pt`` file or a training run directory).
 
         Raises:
-            CheckpointError: naming the file, if a shipped policy is missing or corrupt.
+            CheckpointError: naming the file, if a policy is missing or corrupt.
         """
-        paths = [shipped_policy_path(n) for n in SHIPPED_POLICIES]
-        for p in paths:
-            if not p.is_file():
-                raise CheckpointError(
-                    f"shipped policy not found: {p}; train one with "
-                    f"`explaindrive train --mode {p.stem}` and copy its policy.pt/.json there"
-                )
+        paths = [_policy_path(n, o) for n, o in zip(SHIPPED_POLICIES, (fast, comfort), strict=True)]
         return cls.from_files(paths[0], paths[1], use_shield=use_shield)
 
     def set_command(self, command: Command | str | int) -> None:
@@ -187,3 +187,22 @@ class MergedController:
         self.last_override = decision.overridden
         self.overrides += int(decision.overridden)
         return decision.action if self.use_shield else self.last_network_action
+
+
+def _policy_path(name: str, override: str | Path | None) -> Path:
+    """``override`` (a training run directory holds its ``policy.pt``), else the shipped
+    ``name`` policy.
+
+    Raises:
+        CheckpointError: if the shipped policy is not installed.
+    """
+    if override is not None:
+        path = Path(override).expanduser()
+        return path / "policy.pt" if path.is_dir() else path
+    path = shipped_policy_path(name)
+    if not path.is_file():
+        raise CheckpointError(
+            f"shipped policy not found: {path}; train one with "
+            f"`explaindrive train --mode {name}` and copy its policy.pt/.json there"
+        )
+    return path

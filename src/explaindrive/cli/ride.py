@@ -24,6 +24,7 @@ from rich.console import Console
 from rich.live import Live
 
 from explaindrive.cli._errors import print_error
+from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
 from explaindrive.language.config import LanguageConfig
 from explaindrive.redact import redact
 from explaindrive.ride.config import RideConfig
@@ -95,6 +96,8 @@ def ride(
     max_steps: MaxStepsOption = 600,
     cooldown: CooldownOption = 15.0,
     live: LiveOption = True,
+    fast_policy: FastPolicyOption = None,
+    comfort_policy: ComfortPolicyOption = None,
 ) -> None:
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     if voice and not interactive:
@@ -110,6 +113,8 @@ def ride(
             explanation_cooldown_s=cooldown,
             realtime=realtime or interactive,
             gui=gui,
+            fast_policy=fast_policy,
+            comfort_policy=comfort_policy,
         )
         language_config = LanguageConfig()
         lines = _script_lines(script, interactive, max_steps)
@@ -165,7 +170,9 @@ def _build_session(
     from explaindrive.ride.session import RideSession
 
     try:
-        controller = MergedController.from_package()
+        controller = MergedController.from_package(
+            fast=config.fast_policy, comfort=config.comfort_policy
+        )
         stack = make_language_stack(config.backend, language_config)
         language = stack.load(speech=speech or any(ln.audio for ln in lines))
         return RideSession(config, controller, language)

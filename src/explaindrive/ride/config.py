@@ -6,7 +6,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator, NonNegativeFloat, PositiveInt
 
-from explaindrive.config import ConfigModel, Seed, TrafficLevel
+from explaindrive.config import ConfigModel, Seed, TextPath, TrafficLevel
 from explaindrive.language.backends import check_backend
 
 
@@ -28,6 +28,9 @@ class RideConfig(ConfigModel):
         explain_deadline_s: wall-time budget of one decision or explanation [s].
         realtime: pace the ride at one step per second.
         gui: show the ride in sumo-gui.
+        fast_policy: the fast network to ride with instead of the shipped one (a policy
+            ``.pt`` file or a training run directory).
+        comfort_policy: likewise for the comfort network.
     """
 
     config_name = "ride config"
@@ -44,3 +47,5 @@ class RideConfig(ConfigModel):
     explain_deadline_s: NonNegativeFloat = 1.0
     realtime: bool = False
     gui: bool = False
+    fast_policy: TextPath | None = None
+    comfort_policy: TextPath | None = None
