@@ -28,8 +28,8 @@ class RideConfig(ConfigModel):
         explain_deadline_s: wall-time budget of one decision or explanation [s].
         realtime: pace the ride at one step per second.
         gui: show the ride in sumo-gui.
-        fast_policy: the fast network to ride with instead of the shipped one (a policy
-            ``.pt`` file or a training run directory).
+        fast_policy: the fast network ``explaindrive ride`` loads instead of the shipped
+            one (a policy ``.pt`` file or a training run directory); kept in the summary.
         comfort_policy: likewise for the comfort network.
     """
 
