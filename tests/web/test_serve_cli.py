@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 import typer
 from typer.testing import CliRunner
 
 from explaindrive.cli import serve
+from tests.helpers import constant_policy
 
 app = typer.Typer()
 serve.register(app)
@@ -32,3 +35,27 @@ def test_the_served_names_reach_the_app(monkeypatch: pytest.MonkeyPatch) -> None
     assert "exposes the ride controls" in res.output and served["host"] == "0.0.0.0"
     (guard,) = [m for m in served["app"].user_middleware if m.cls is RequestGuard]  # type: ignore[attr-defined]
     assert guard.kwargs["hosts"] == {"127.0.0.1", "localhost", "::1", "car.local"}
+
+
+def test_a_missing_policy_exits_before_serving(tmp_path: Path) -> None:
+    res = runner.invoke(app, ["serve", "--fast-policy", str(tmp_path / "nope.pt")])
+    assert res.exit_code == 2
+    assert "policy file not found" in res.output
+
+
+def test_a_trained_network_reaches_the_rides(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    import uvicorn
+
+    from explaindrive.web.app import RealStack
+
+    run = tmp_path / "run"  # a training run directory
+    run.mkdir()
+    constant_policy(run / "policy.pt", 0, {"name": "mine"})
+    served: dict[str, object] = {}
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.update(app=app, **kw))
+    res = runner.invoke(app, ["serve", "--fast-policy", str(run)])
+    assert res.exit_code == 0, res.output
+    stack = served["app"].state.manager.session_factory  # type: ignore[attr-defined]
+    assert isinstance(stack, RealStack) and stack.policies == (run, None)

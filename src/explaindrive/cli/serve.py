@@ -6,6 +6,7 @@ import typer
 from rich.console import Console
 
 from explaindrive.cli._errors import print_error
+from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
 from explaindrive.language.backends import check_backend
 from explaindrive.language.encoders import check_installed
 
@@ -32,17 +33,24 @@ def serve(
         "--allow-host",
         help="Another name the page is opened under (repeatable; e.g. the machine's LAN name).",
     ),
+    fast_policy: FastPolicyOption = None,
+    comfort_policy: ComfortPolicyOption = None,
 ) -> None:
     """Serve the passenger page: watch the ride, talk to the car, read its explanations."""
     import uvicorn
 
+    from explaindrive.agent.checkpoint import CheckpointError
+    from explaindrive.agent.controller import MergedController
     from explaindrive.web import create_app
+    from explaindrive.web.app import RealStack
     from explaindrive.web.guard import LOOPBACK_HOSTS, served_hosts
 
     try:  # before the server starts
         check_backend(backend)
         check_installed()
-    except (FileNotFoundError, ValueError) as exc:
+        if fast_policy is not None or comfort_policy is not None:  # loads them once to check
+            MergedController.from_package(fast=fast_policy, comfort=comfort_policy)
+    except (FileNotFoundError, ValueError, CheckpointError) as exc:
         print_error(console, exc)
         raise typer.Exit(2) from exc
     hosts = served_hosts(host, allow_host)
@@ -51,7 +59,8 @@ def serve(
             f"[yellow]warning:[/yellow] binding {host} exposes the ride controls to the network"
         )
     console.print(f"answering Host names: {', '.join(sorted(hosts))}", highlight=False)
-    app = create_app(backend=backend, step_period_s=step_period, hosts=hosts)
+    stack = RealStack(backend, fast_policy, comfort_policy)
+    app = create_app(stack, step_period_s=step_period, hosts=hosts)
     console.print(f"passenger page: http://{host}:{port}/  (Ctrl+C to stop)")
     uvicorn.run(app, host=host, port=port, log_level="warning")
 

@@ -67,17 +67,27 @@ WS_QUEUE_FRAMES = 64  # frames a slow page may lag before it is resynchronised
 
 
 class RealStack:
-    """The default session factory: shipped policies and the chosen language backend.
+    """The default session factory: the shipped policies (or others in their place) and the
+    chosen language backend.
 
     The controller and the language models load on the first ride (on the ride
     worker thread) and are reused by the rides that follow.
 
     Args:
         backend: language backend, ``embedded`` or ``openai``.
+        fast_policy: a fast network in place of the shipped one (a policy ``.pt`` file or
+            a training run directory).
+        comfort_policy: likewise for the comfort network.
     """
 
-    def __init__(self, backend: str = "embedded") -> None:
+    def __init__(
+        self,
+        backend: str = "embedded",
+        fast_policy: Path | None = None,
+        comfort_policy: Path | None = None,
+    ) -> None:
         self.backend = check_backend(backend)
+        self.policies = (fast_policy, comfort_policy)
         self._controller: Any = None
         self._language: Any = None
 
@@ -88,10 +98,13 @@ class RealStack:
         from explaindrive.language.stack import make_language_stack
 
         if self._controller is None:
-            self._controller = MergedController.from_package()
+            fast, comfort = self.policies
+            self._controller = MergedController.from_package(fast=fast, comfort=comfort)
         if self._language is None:
             self._language = make_language_stack(self.backend, LanguageConfig()).load()
-        return RideSession(config.replace(backend=self.backend), self._controller, self._language)
+        fast, comfort = self.policies
+        config = config.replace(backend=self.backend, fast_policy=fast, comfort_policy=comfort)
+        return RideSession(config, self._controller, self._language)
 
 
 def create_app(
