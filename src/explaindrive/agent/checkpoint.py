@@ -39,6 +39,7 @@ POLICY_FORMAT = "explaindrive-policy"
 FORMAT_VERSION = 1
 CHECKPOINT_FILE = "checkpoint.pt"
 CONFIG_FILE = "config.json"
+POLICY_FILE = "policy.pt"  # a training run's final policy, its card next to it
 # Fields a resumed run must share with its checkpoint; the others (episodes, logging...)
 # may change between runs.
 STRUCTURAL_FIELDS: tuple[str, ...] = ("mode", "hidden_sizes", "buffer_size")
@@ -186,6 +187,13 @@ def save_policy(path: Path, network: DuelingQNetwork, card: dict[str, Any]) -> t
     card_path = path.with_suffix(".json")
     atomic_write_text(card_path, json.dumps(card, indent=2, sort_keys=True, default=str))
     return path, card_path
+
+
+def policy_file(path: str | Path) -> Path:
+    """The policy file ``path`` names: a training run directory's :data:`POLICY_FILE`, else
+    ``path`` with the ``.pt`` suffix (which :func:`load_policy` reads). Not checked to exist."""
+    p = Path(path).expanduser()
+    return p / POLICY_FILE if p.is_dir() else p.with_suffix(".pt")
 
 
 def load_policy(path: Path) -> tuple[DuelingQNetwork, dict[str, Any]]:

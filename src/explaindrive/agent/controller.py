@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from explaindrive.agent.checkpoint import CheckpointError, load_policy
+from explaindrive.agent.checkpoint import CheckpointError, load_policy, policy_file
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
@@ -197,8 +197,7 @@ def _policy_path(name: str, override: str | Path | None) -> Path:
         CheckpointError: if the shipped policy is not installed.
     """
     if override is not None:
-        path = Path(override).expanduser()
-        return path / "policy.pt" if path.is_dir() else path
+        return policy_file(override)
     path = shipped_policy_path(name)
     if not path.is_file():
         raise CheckpointError(

@@ -41,6 +41,7 @@ import torch
 from explaindrive.agent.buffer import ReplayBuffer
 from explaindrive.agent.checkpoint import (
     CHECKPOINT_FILE,
+    POLICY_FILE,
     CheckpointError,
     atomic_write_text,
     load_checkpoint,
@@ -313,7 +314,7 @@ class Trainer:
             "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
             "evaluation": None,
         }
-        policy_path, _ = save_policy(self.out_dir / "policy.pt", self.learner.q, card)
+        policy_path, _ = save_policy(self.out_dir / POLICY_FILE, self.learner.q, card)
         curve = plot_training_curve(
             self.csv_path,
             self.out_dir / "training_curve.png",

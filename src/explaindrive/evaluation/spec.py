@@ -263,11 +263,9 @@ def _card_mode(path: Path) -> str | None:
 
 
 def _policy_file(text: str) -> Path:
-    path = Path(text).expanduser()
-    if path.is_dir():
-        path = path / "policy.pt"
-    if path.suffix != ".pt":
-        path = path.with_suffix(".pt")
+    from explaindrive.agent.checkpoint import policy_file
+
+    path = policy_file(text)
     if not path.is_file():
         raise SpecError(
             f"policy file not found: {path} (POLICY is one of {', '.join(POLICY_NAMES)} "

@@ -97,12 +97,11 @@ class RealStack:
         from explaindrive.language.config import LanguageConfig
         from explaindrive.language.stack import make_language_stack
 
+        fast, comfort = self.policies
         if self._controller is None:
-            fast, comfort = self.policies
             self._controller = MergedController.from_package(fast=fast, comfort=comfort)
         if self._language is None:
             self._language = make_language_stack(self.backend, LanguageConfig()).load()
-        fast, comfort = self.policies
         config = config.replace(backend=self.backend, fast_policy=fast, comfort_policy=comfort)
         return RideSession(config, self._controller, self._language)
 
