@@ -41,3 +41,19 @@ def test_seed_pool_bounds_the_episode_seeds() -> None:
     cfg = PAPER.replace(seed_pool=3)
     seeds = {plan_episode(cfg, i).seed for i in range(60)}
     assert seeds == {SEED_POOL_BASE, SEED_POOL_BASE + 1, SEED_POOL_BASE + 2}
+
+
+def test_observation_noise_is_drawn_per_episode_within_its_bounds() -> None:
+    cfg = PAPER.replace(obs_noise_max=(3.0, 0.9))
+    plans = [plan_episode(cfg, i) for i in range(40)]
+    noises = {p.obs_noise for p in plans}
+    assert len(noises) == 40
+    assert all(0.0 <= m <= 3.0 and 0.0 <= s <= 0.9 for m, s in noises)
+    assert plan_episode(cfg, 7) == plans[7]
+    assert plans[0].reset_options()["obs_noise"] == list(plans[0].obs_noise)
+    # the noise has its own generator: the rest of the plan is the one without noise
+    plain = plan_episode(PAPER, 7)
+    assert (plain.seed, plain.traffic_level, plain.command_schedule) == (
+        plans[7].seed, plans[7].traffic_level, plans[7].command_schedule,
+    )  # fmt: skip
+    assert "obs_noise" not in plain.reset_options()

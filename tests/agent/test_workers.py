@@ -97,6 +97,28 @@ def test_the_learning_mask_follows_the_dilemma_braking_setting(
         assert mask.sum() == next_mask.sum() == allowed and mask[3]
 
 
+class _NoisySensor(FakeDriveEnv):
+    """Sees an empty road while the true state (``info["true_obs"]``) is _YellowAhead's."""
+
+    true = np.array([0, 13.0, 13.9, 17.9, 13.0, 17.9, 1.0, 200.0], dtype=np.float32)
+
+    def reset(self, *, seed=None, options=None):  # type: ignore[no-untyped-def]
+        obs, info = super().reset(seed=seed, options=options)
+        return obs, {**info, "true_obs": self.true}
+
+    def step(self, action: int):  # type: ignore[no-untyped-def]
+        obs, reward, terminated, truncated, info = super().step(action)
+        return obs, reward, terminated, truncated, {**info, "true_obs": self.true}
+
+
+def test_the_learning_mask_is_computed_on_the_true_state() -> None:
+    worker = RolloutWorker(CONFIG, functools.partial(_NoisySensor, max_steps=5), 0)
+    rollout = worker.collect(CollectRequest(steps=5, epsilon=0.5, weights=_weights(), start=0))
+    for obs, *_, mask, next_mask in rollout.transitions:
+        assert obs[5] == 200.0  # the network learns from what it sees...
+        assert mask.sum() == next_mask.sum() == 4  # ...and the masks from the true state
+
+
 _KILLED_PARENT = """
 import functools, os, signal, sys
 sys.path.insert(0, {root!r})

@@ -118,5 +118,63 @@ def test_stop_reward_terms_only_hold_the_stop_term():
         "speed": 0.0,
         "collision": 0.0,
         "stop": -50.0,
+        "time": 0.0,
+        "brake": 0.0,
         "total": -50.0,
     }
+
+
+def test_hard_brake_penalty_charges_braking_beyond_one_mps2():
+    assert R.hard_brake_penalty(-1.0, 0.5) == 0.0
+    assert R.hard_brake_penalty(2.0, 0.5) == 0.0
+    assert R.hard_brake_penalty(-2.0, 0.5) == -0.5  # 0.5 * 1^2
+    assert R.hard_brake_penalty(-3.0, 0.25) == -1.0  # 0.25 * 2^2
+
+
+def test_passenger_fast_terms():
+    # braking at -3 m/s per step while closing in on a stop line (a virtual leader)
+    f = _features(speed_change_mps=-3, accel_mps2=-3.0, leader_gap_m=10.0)
+    t = R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE)
+    assert t.ttc == pytest.approx(2 * -0.693147, abs=1e-6)
+    assert t.headway == 0.0  # no real leader: a stop line earns no headway reward
+    assert t.jerk == pytest.approx(-0.1 * 4)
+    assert t.speed == pytest.approx(3 * 10 / 13.89)
+    assert t.time == -0.5
+    assert t.brake == -1.0
+    # -1.386294 - 0.4 + 2.159827 - 0.5 - 1.0 = -1.126467
+    assert t.total == pytest.approx(-1.126467, abs=1e-5)
+
+
+def test_passenger_headway_pays_for_a_real_leader():
+    f = _features(real_headway_s=1.0)
+    t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
+    assert t.headway == pytest.approx(1.5 * 0.571990, abs=1e-5)
+    assert t.speed == pytest.approx(3 * 10 / 13.89)  # comfort's progress weighs as fast's
+    assert t.jerk == -4.0
+
+
+@pytest.mark.parametrize(
+    ("gap_m", "paper", "passenger"),
+    [(3.0, 2.0, 1.0), (1.0, 2.0, 1.0), (5.0, 2.0, 1.0), (8.0, 2.0, 0.0), (0.5, 2.0, 0.0)],
+)
+def test_standing_for_a_signal_pays_only_near_the_line(gap_m, paper, passenger):
+    f = _features(
+        speed_mps=0.0, speed_change_mps=-1, ttc_s=math.inf, headway_s=math.inf, jerk_mps3=0.0,
+        stop_reason="signal", leader_gap_m=gap_m,
+    )  # fmt: skip
+    assert R.reward_terms(Command.COMFORT, f).traffic == paper
+    t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
+    assert t.traffic == passenger
+    assert t.total == pytest.approx(passenger - 0.5)  # and the charge for time
+
+
+def test_a_stop_pays_less_than_driving_at_the_limit():
+    for w in (R.PASSENGER_RECIPE.fast, R.PASSENGER_RECIPE.comfort):
+        assert w.signal_stop - w.time < w.speed - w.time
+
+
+def test_recipes_are_named_and_stop_has_no_weights():
+    assert R.REWARD_NAMES == ("paper", "passenger")
+    assert R.RECIPES["paper"].fast.headway == 3.0
+    with pytest.raises(ValueError, match="R2"):
+        R.PAPER_RECIPE.weights(Command.STOP)

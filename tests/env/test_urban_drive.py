@@ -206,6 +206,8 @@ def test_info_carries_the_reward_terms(make_env):
         "speed",
         "collision",
         "stop",
+        "time",
+        "brake",
         "total",
     }
     assert terms["total"] == pytest.approx(reward)
@@ -290,3 +292,32 @@ def test_pedestrians_do_not_step_in_front_of_the_ego_at_the_zebra(make_env):
             if terminated or truncated or front > zebra.end_m + 50.0:
                 break
     assert held_steps > 0  # the rule was exercised
+
+
+def test_noise_reaches_the_observation_and_not_the_judgement(make_env):
+    def drive(env):
+        obs, info = env.reset(seed=4)
+        seen, true, rewards = [obs], [info.get("true_obs", obs)], []
+        for _ in range(5):
+            obs, reward, _, _, info = env.step(action_index(2))
+            seen.append(obs)
+            true.append(info.get("true_obs", obs))
+            rewards.append(reward)
+        return seen, true, rewards
+
+    clean_seen, _, clean_rewards = drive(make_env(traffic_level=0.5))
+    noisy_seen, noisy_true, noisy_rewards = drive(make_env(traffic_level=0.5, obs_noise=(2.0, 0.6)))
+    np.testing.assert_array_equal(np.array(noisy_true), np.array(clean_seen))
+    assert noisy_rewards == pytest.approx(clean_rewards)  # rewards come from the true state
+    assert [o[S.V_LIM] for o in noisy_seen] == [o[S.V_LIM] for o in clean_seen]
+    assert noisy_seen[-1][S.V_EGO] != clean_seen[-1][S.V_EGO]
+
+
+def test_reset_option_sets_the_episode_noise(make_env):
+    env = make_env(traffic_level=0.5)
+    obs_a, info = env.reset(seed=4, options={"obs_noise": [1.0, 0.3]})
+    assert "true_obs" in info
+    obs_b, _ = env.reset(seed=4, options={"obs_noise": [1.0, 0.3]})
+    np.testing.assert_array_equal(obs_a, obs_b)  # the same seed, the same noise
+    _, info = env.reset(seed=4)
+    assert "true_obs" not in info

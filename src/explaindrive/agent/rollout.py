@@ -48,13 +48,15 @@ def reseed(seed: int, attempt: int) -> int:
 
 
 def make_urban_drive_env(
-    max_steps: int | None = None, yellow_leader: str = DEFAULT_YELLOW_LEADER
+    max_steps: int | None = None,
+    yellow_leader: str = DEFAULT_YELLOW_LEADER,
+    reward: str = "paper",
 ) -> gym.Env:
     """The project's SUMO environment (imported lazily: each worker builds its own)."""
     from explaindrive.env.config import EnvConfig
     from explaindrive.env.urban_drive import UrbanDriveEnv
 
-    config = EnvConfig(yellow_leader=yellow_leader)
+    config = EnvConfig(yellow_leader=yellow_leader, reward=reward)
     return UrbanDriveEnv(
         config=config if max_steps is None else config.replace(max_steps=max_steps)
     )
@@ -62,11 +64,20 @@ def make_urban_drive_env(
 
 def default_env_factory(config: TrainConfig) -> EnvFactory:
     """Picklable factory of the real environment for ``config``."""
-    return functools.partial(make_urban_drive_env, config.max_episode_steps, config.yellow_leader)
+    return functools.partial(
+        make_urban_drive_env, config.max_episode_steps, config.yellow_leader, config.reward
+    )
 
 
 Transition = tuple[np.ndarray, int, float, np.ndarray, bool, float, np.ndarray, np.ndarray]
 """(obs, action, return, next_obs, terminated, discount, mask, next_mask)"""
+
+
+def _true_state(obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+    """The true state behind an observation: the masks of learning are computed on it, so a
+    network that sees noisy observations learns the margin the noise calls for."""
+    true = info.get("true_obs")
+    return obs if true is None else np.asarray(true, dtype=np.float32)
 
 
 class NStepQueue:
@@ -230,7 +241,7 @@ class RolloutWorker:
         c = self.config
         for attempt in range(MAX_RESET_ATTEMPTS):
             try:
-                obs, _ = self.env.reset(seed=plan.seed, options=plan.reset_options())
+                obs, info = self.env.reset(seed=plan.seed, options=plan.reset_options())
             except (RuntimeError, OSError) as exc:  # e.g. the ego cannot enter a blocked road
                 out.reset_failures += 1
                 log.warning("episode %d (seed %d) could not start: %s; new seed",
@@ -238,6 +249,7 @@ class RolloutWorker:
                 plan = replace(plan, seed=reseed(plan.seed, attempt))
                 continue
             obs = np.asarray(obs, dtype=np.float32)
+            true_obs = _true_state(obs, info)
             shielded = c.safe_learning and plan.index < c.shielded_fraction * c.episodes
             summary = EpisodeSummary(
                 plan.index, plan.seed, plan.traffic_level, plan.has_stops, shielded
@@ -245,7 +257,7 @@ class RolloutWorker:
             return _Running(
                 plan, summary, NStepQueue(c.n_step, c.gamma),
                 np.random.default_rng([c.seed, 3, plan.index]), obs,
-                training_mask(obs, c.dilemma_braking), runtime_mask(obs),
+                training_mask(true_obs, c.dilemma_braking), runtime_mask(true_obs),
             )  # fmt: skip
         raise RuntimeError(
             f"worker {self.worker_id}: episode {plan.index} failed to start "
@@ -260,14 +272,15 @@ class RolloutWorker:
         action = int(D3QNLearner.explore(q, epsilon, ep.rng, act_mask)[0])
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         next_obs = np.asarray(next_obs, dtype=np.float32)
-        next_mask = training_mask(next_obs, self.config.dilemma_braking)
+        next_true = _true_state(next_obs, info)
+        next_mask = training_mask(next_true, self.config.dilemma_braking)
         done = bool(terminated or truncated)
         out.transitions += ep.queue.push(
             ep.obs, action, float(reward), ep.mask, next_obs, next_mask, bool(terminated), done
         )
         out.steps += 1
         ep.summary.record(float(reward), info, greedy_unsafe)
-        ep.obs, ep.mask, ep.allowed = next_obs, next_mask, runtime_mask(next_obs)
+        ep.obs, ep.mask, ep.allowed = next_obs, next_mask, runtime_mask(next_true)
         if done:
             ep.summary.terminated = bool(terminated)
             ep.summary.ended_at_step = out.steps

@@ -27,6 +27,7 @@ class EpisodePlan:
     traffic_level: float
     command: Command
     command_schedule: tuple[tuple[float, str], ...]  # (time [s], command label) switches
+    obs_noise: tuple[float, float] = (0.0, 0.0)  # (sd_m, sd_mps) of the observation noise
 
     @property
     def has_stops(self) -> bool:
@@ -35,11 +36,14 @@ class EpisodePlan:
 
     def reset_options(self) -> dict[str, Any]:
         """The ``options`` of ``env.reset`` for this episode."""
-        return {
+        options: dict[str, Any] = {
             "command": self.command.label,
             "traffic_level": self.traffic_level,
             "command_schedule": [list(s) for s in self.command_schedule],
         }
+        if self.obs_noise != (0.0, 0.0):
+            options["obs_noise"] = list(self.obs_noise)
+        return options
 
 
 def stop_schedule(
@@ -82,4 +86,12 @@ def plan_episode(config: TrainConfig, index: int) -> EpisodePlan:
         schedule = stop_schedule(
             rng, primary, config.stop_gap_s, config.stop_duration_s, config.schedule_horizon_s
         )
-    return EpisodePlan(index, seed, level, primary, schedule)
+    noise = (0.0, 0.0)
+    if config.obs_noise_max != (0.0, 0.0):
+        # a generator of its own: the plans of runs without noise stay as they were
+        u = np.random.default_rng([config.seed, index, 11]).uniform(size=2)
+        noise = (
+            round(float(u[0]) * config.obs_noise_max[0], 3),
+            round(float(u[1]) * config.obs_noise_max[1], 3),
+        )
+    return EpisodePlan(index, seed, level, primary, schedule, noise)

@@ -11,6 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from explaindrive.agent.config import (
+    DEFAULT_PRESET,
     TRAIN_MODES,
     ConfigError,
     TrainConfig,
@@ -68,7 +69,7 @@ def resolve_config(
         if config_file is not None:
             data.update(load_config_file(config_file))
         return TrainConfig.from_dict({**data, **changes})
-    return build_config(preset or "safe", config_file, changes)
+    return build_config(preset or DEFAULT_PRESET, config_file, changes)
 
 
 ModeOption = Annotated[str, typer.Option("--mode", "-m", help="Agent to train: fast or comfort.")]
@@ -84,7 +85,9 @@ ResumeOption = Annotated[
 ]
 PresetOption = Annotated[
     str | None,
-    typer.Option("--preset", help="safe or paper (default: safe; the run's own on --resume)."),
+    typer.Option(
+        "--preset", help="passenger, safe or paper (default: passenger; the run's own on --resume)."
+    ),
 ]
 SeedOption = Annotated[int | None, typer.Option("--seed", help="Base seed of the run.")]
 ConfigFileOption = Annotated[

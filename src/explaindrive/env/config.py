@@ -5,10 +5,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Annotated, Any
 
-from pydantic import NonNegativeInt, PositiveInt
+from pydantic import Field, NonNegativeInt, PositiveInt, field_validator
 
-from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
+from explaindrive.config import FROM_LIST, ConfigModel, TextPath, TrafficLevel, one_of
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
+from explaindrive.env.noise import ObservationNoise
+from explaindrive.env.reward import REWARD_NAMES
+
+NoiseSD = Annotated[tuple[float, float], FROM_LIST]  # (sd_m, sd_mps)
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
@@ -31,6 +35,11 @@ class EnvConfig(ConfigModel):
         yellow_leader: when a yellow light's stop line is a virtual leader: ``"decided"``
             once, when the ego first sees the yellow, by whether it can still stop there
             (:mod:`explaindrive.env.lights`), or ``"always"``, as in the paper.
+        reward: the reward recipe, ``"paper"`` or ``"passenger"``
+            (:mod:`explaindrive.env.reward`).
+        obs_noise: ``(sd_m, sd_mps)`` of the Gaussian noise on the observed distances and
+            speeds (:mod:`explaindrive.env.noise`); violations and rewards are judged on
+            the true state, which ``info["true_obs"]`` holds when noise is on.
     """
 
     config_name = "env config"
@@ -44,6 +53,19 @@ class EnvConfig(ConfigModel):
     insert_timeout_s: PositiveInt = 60
     ego_model: Annotated[str, one_of(EGO_MODELS)] = "agent"
     yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = DEFAULT_YELLOW_LEADER
+    reward: Annotated[str, one_of(REWARD_NAMES)] = "paper"
+    obs_noise: NoiseSD = Field(default=(0.0, 0.0))
+
+    @field_validator("obs_noise")
+    @classmethod
+    def _noise_in_range(cls, value: tuple[float, float]) -> tuple[float, float]:
+        ObservationNoise(*value)  # raises ValueError naming the range
+        return value
+
+    @property
+    def noise(self) -> ObservationNoise:
+        """The observation noise as an :class:`ObservationNoise`."""
+        return ObservationNoise(*self.obs_noise)
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any]) -> EnvConfig:

@@ -8,9 +8,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from explaindrive.commands import Command
+from explaindrive.env.noise import ObservationNoise
 from explaindrive.sim.scenario.layout import validate_traffic_level
 
-_KEYS = ("command", "traffic_level", "command_schedule")
+_KEYS = ("command", "traffic_level", "command_schedule", "obs_noise")
 
 
 @dataclass(frozen=True, slots=True)
@@ -21,11 +22,13 @@ class ResetOptions:
         command: command active from the first step.
         traffic_level: demand scale for this episode (``None``: the config's).
         command_schedule: ``(time_s, command)`` switches, time from the episode start.
+        noise: the observation noise of this episode (``None``: the config's).
     """
 
     command: Command = Command.FAST
     traffic_level: float | None = None
     command_schedule: tuple[tuple[float, Command], ...] = ()
+    noise: ObservationNoise | None = None
 
     @classmethod
     def parse(cls, options: Mapping[str, Any] | None) -> ResetOptions:
@@ -44,7 +47,12 @@ class ResetOptions:
         if level is not None:
             level = validate_traffic_level(level)
         schedule = parse_schedule(options.get("command_schedule") or ())
-        return cls(command=command, traffic_level=level, command_schedule=schedule)
+        noise = options.get("obs_noise")
+        if noise is not None:
+            if not isinstance(noise, Sequence) or isinstance(noise, str) or len(noise) != 2:
+                raise ValueError(f"obs_noise must be (sd_m, sd_mps), got {noise!r}")
+            noise = ObservationNoise(float(noise[0]), float(noise[1]))
+        return cls(command=command, traffic_level=level, command_schedule=schedule, noise=noise)
 
 
 def parse_schedule(items: Sequence[Any]) -> tuple[tuple[float, Command], ...]:

@@ -1,8 +1,21 @@
-"""The paper's reward functions: one place for the constants and one small function per term.
+"""The reward functions: one place for the constants and one small function per term.
+
+The paper's rewards (recipe ``paper``):
 
 ``R0`` (fast)    = R_eff_cf + R_traffic + R_speed(3) + R_collision
 ``R1`` (comfort) = R_comf_cf + R_traffic + R_speed(1.5) + R_collision
 ``R2`` (stop)    = r_respect if v = 0; -r_critical if a >= 0; 0 otherwise
+
+The ``passenger`` recipe keeps every term and changes weights and where they apply
+(:data:`RECIPES`; each change is a row of docs/agent.md's deviations table):
+
+* the headway term pays for following real vehicles only, not for closing in on a stop line;
+* a charge per step for time (``time``), so that getting there pays;
+* standing for a light or a pedestrian pays only within 1-5 m of the line, and less than
+  driving (``signal_stop``, ``stop_window_m``);
+* jerk is charged under fast too (lightly), and braking harder than 1 m/s^2 is charged
+  (``hard_brake``), more under comfort;
+* comfort's progress is worth as much as fast's: the two differ in smoothness.
 """
 
 from __future__ import annotations
@@ -26,6 +39,90 @@ COMFORT_CF_WEIGHTS = (2.0, 1.5)
 FAST_SPEED_WEIGHT = 3.0
 COMFORT_SPEED_WEIGHT = 1.5
 STOP_REASON_GAP_M = 15.0  # [m] a leader this close justifies standing still
+GENTLE_BRAKE_MPS2 = 1.0  # [m/s^2] braking up to this is not charged by ``hard_brake``
+
+
+@dataclass(frozen=True, slots=True)
+class RewardWeights:
+    """Weights of one driving command's reward (fast or comfort).
+
+    Attributes:
+        ttc: weight of f_TTC (w.r.t. the effective leader, stop lines included).
+        headway: weight of f_headway.
+        headway_on_stop_lines: whether f_headway also pays for a stop line (a virtual
+            leader); the paper's reward does.
+        speed: weight of v / v_lim.
+        time: charge per step [reward/s].
+        jerk: weight of -jerk^2.
+        hard_brake: weight of -(braking beyond :data:`GENTLE_BRAKE_MPS2`)^2.
+        signal_stop: paid per step standing for a light or a pedestrian.
+        stop_window_m: ``(min, max)`` distance to the line within which ``signal_stop`` is
+            paid; ``None`` pays it at any distance (the paper).
+    """
+
+    ttc: float
+    headway: float
+    headway_on_stop_lines: bool
+    speed: float
+    time: float = 0.0
+    jerk: float = 0.0
+    hard_brake: float = 0.0
+    signal_stop: float = R_RESPECT
+    stop_window_m: tuple[float, float] | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class RewardRecipe:
+    """The weights of the fast and comfort rewards (stop always uses R2)."""
+
+    name: str
+    fast: RewardWeights
+    comfort: RewardWeights
+
+    def weights(self, command: Command) -> RewardWeights:
+        """The weights of a driving command.
+
+        Raises:
+            ValueError: for STOP, whose reward has no weights.
+        """
+        if command is Command.STOP:
+            raise ValueError("the stop reward R2 has no weights")
+        return self.fast if command is Command.FAST else self.comfort
+
+
+PAPER_RECIPE = RewardRecipe(
+    "paper",
+    fast=RewardWeights(*FAST_CF_WEIGHTS, headway_on_stop_lines=True, speed=FAST_SPEED_WEIGHT),
+    comfort=RewardWeights(
+        *COMFORT_CF_WEIGHTS, headway_on_stop_lines=True, speed=COMFORT_SPEED_WEIGHT, jerk=1.0
+    ),
+)
+STOP_WINDOW_M = (1.0, 5.0)  # [m] where a car standing for a light or a pedestrian should stand
+PASSENGER_RECIPE = RewardRecipe(
+    "passenger",
+    fast=RewardWeights(
+        *FAST_CF_WEIGHTS,
+        headway_on_stop_lines=False,
+        speed=FAST_SPEED_WEIGHT,
+        time=0.5,
+        jerk=0.1,
+        hard_brake=0.25,
+        signal_stop=1.0,
+        stop_window_m=STOP_WINDOW_M,
+    ),
+    comfort=RewardWeights(
+        *COMFORT_CF_WEIGHTS,
+        headway_on_stop_lines=False,
+        speed=FAST_SPEED_WEIGHT,
+        time=0.5,
+        jerk=1.0,
+        hard_brake=0.5,
+        signal_stop=1.0,
+        stop_window_m=STOP_WINDOW_M,
+    ),
+)
+RECIPES: dict[str, RewardRecipe] = {r.name: r for r in (PAPER_RECIPE, PASSENGER_RECIPE)}
+REWARD_NAMES: tuple[str, ...] = tuple(RECIPES)
 
 
 def time_to_collision(gap_m: float, closing_speed_mps: float) -> float:
@@ -69,9 +166,15 @@ def speed_reward(speed_mps: float, limit_mps: float, weight: float) -> float:
     return weight * speed_mps / limit_mps if limit_mps > 0 else 0.0
 
 
-def traffic_rules_reward(*, violation: bool, stopped: bool, stop_reason: str | None) -> float:
-    """R_traffic: -r_unsafe for a violation or a stop without reason, +r_respect for a stop
-    at a red light or for a pedestrian.
+def traffic_rules_reward(
+    *,
+    violation: bool,
+    stopped: bool,
+    stop_reason: str | None,
+    signal_stop: float = R_RESPECT,
+) -> float:
+    """R_traffic: -r_unsafe for a violation or a stop without reason, ``signal_stop``
+    (the paper: +r_respect) for a stop at a red light or for a pedestrian.
 
     Args:
         violation: a red light was run or a pedestrian crossing was violated in this step.
@@ -79,15 +182,22 @@ def traffic_rules_reward(*, violation: bool, stopped: bool, stop_reason: str | N
         stop_reason: why standing still is justified: ``"signal"`` (red/yellow light or
             pedestrian, i.e. the virtual leader), ``"queue"`` (a real vehicle close
             ahead) or ``None``.
+        signal_stop: what a stop for a signal pays.
     """
     if violation:
         return -R_UNSAFE
     if stopped:
         if stop_reason == "signal":
-            return R_RESPECT
+            return signal_stop
         if stop_reason is None:
             return -R_UNSAFE
     return 0.0
+
+
+def hard_brake_penalty(accel_mps2: float, weight: float) -> float:
+    """-weight * (braking beyond :data:`GENTLE_BRAKE_MPS2`)^2; 0 for gentler braking."""
+    excess = max(0.0, -accel_mps2 - GENTLE_BRAKE_MPS2)
+    return -weight * excess * excess
 
 
 def collision_reward(collided: bool) -> float:
@@ -112,11 +222,14 @@ class StepFeatures:
     speed_change_mps: int  # the action's speed change
     limit_mps: float  # posted limit the agent observed
     ttc_s: float  # w.r.t. the effective (real or virtual) leader
-    headway_s: float
+    headway_s: float  # w.r.t. the effective leader
     jerk_mps3: float
     violation: bool
     stop_reason: str | None
     collided: bool
+    real_headway_s: float = math.inf  # w.r.t. the real leader (inf without one)
+    accel_mps2: float | None = None  # the step's speed change as driven; None: the action's
+    leader_gap_m: float = math.inf  # gap to the effective leader after the step [m]
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,19 +243,16 @@ class RewardTerms:
     speed: float = 0.0
     collision: float = 0.0
     stop: float = 0.0
+    time: float = 0.0
+    brake: float = 0.0
 
     @property
     def total(self) -> float:
         """Sum of the terms."""
-        return (
-            self.ttc
-            + self.headway
-            + self.jerk
-            + self.traffic
-            + self.speed
-            + self.collision
-            + self.stop
-        )
+        return math.fsum(
+            (self.ttc, self.headway, self.jerk, self.traffic, self.speed, self.collision,
+             self.stop, self.time, self.brake)
+        )  # fmt: skip
 
     def as_dict(self) -> dict[str, float]:
         """Terms plus ``total`` as a plain dict (for ``info``)."""
@@ -154,25 +264,41 @@ class RewardTerms:
             "speed": self.speed,
             "collision": self.collision,
             "stop": self.stop,
+            "time": self.time,
+            "brake": self.brake,
             "total": self.total,
         }
 
 
-def reward_terms(command: Command, f: StepFeatures) -> RewardTerms:
-    """The reward of the active command split into its terms."""
+def _signal_stop(w: RewardWeights, gap_m: float) -> float:
+    """What standing for a signal pays at ``gap_m`` before its line."""
+    if w.stop_window_m is None:
+        return w.signal_stop
+    lo, hi = w.stop_window_m
+    return w.signal_stop if lo <= gap_m <= hi else 0.0
+
+
+def reward_terms(
+    command: Command, f: StepFeatures, recipe: RewardRecipe = PAPER_RECIPE
+) -> RewardTerms:
+    """The reward of the active command under ``recipe``, split into its terms."""
     if command is Command.STOP:
         return RewardTerms(stop=stop_reward(f.speed_mps, f.speed_change_mps))
-    fast = command is Command.FAST
-    w_ttc, w_h = FAST_CF_WEIGHTS if fast else COMFORT_CF_WEIGHTS
+    w = recipe.weights(command)
+    headway = f.headway_s if w.headway_on_stop_lines else f.real_headway_s
+    accel = float(f.speed_change_mps) if f.accel_mps2 is None else f.accel_mps2
     return RewardTerms(
-        ttc=w_ttc * f_ttc(f.ttc_s),
-        headway=w_h * f_headway(f.headway_s),
-        jerk=0.0 if fast else -(f.jerk_mps3**2),
+        ttc=w.ttc * f_ttc(f.ttc_s),
+        headway=w.headway * f_headway(headway),
+        jerk=-w.jerk * f.jerk_mps3**2,
         traffic=traffic_rules_reward(
-            violation=f.violation, stopped=f.speed_mps <= 0.0, stop_reason=f.stop_reason
+            violation=f.violation,
+            stopped=f.speed_mps <= 0.0,
+            stop_reason=f.stop_reason,
+            signal_stop=_signal_stop(w, f.leader_gap_m),
         ),
-        speed=speed_reward(
-            f.speed_mps, f.limit_mps, FAST_SPEED_WEIGHT if fast else COMFORT_SPEED_WEIGHT
-        ),
+        speed=speed_reward(f.speed_mps, f.limit_mps, w.speed),
         collision=collision_reward(f.collided),
+        time=-w.time,
+        brake=hard_brake_penalty(accel, w.hard_brake),
     )

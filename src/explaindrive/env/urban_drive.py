@@ -33,8 +33,10 @@ from explaindrive.env.actions import (
 )
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.lights import AmberDecision
+from explaindrive.env.noise import ObservationNoise
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.reward import (
+    RECIPES,
     STOP_REASON_GAP_M,
     RewardTerms,
     StepFeatures,
@@ -125,6 +127,8 @@ class _Episode:
     pedestrians: PedestrianSource | None = None
     kerb: KerbYield = field(default_factory=KerbYield)
     amber: AmberDecision = field(default_factory=AmberDecision)
+    noise: ObservationNoise = field(default_factory=ObservationNoise)
+    noise_rng: np.random.Generator = field(default_factory=lambda: np.random.default_rng(0))
 
 
 class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
@@ -135,9 +139,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         render_mode: ``None`` (libsumo, headless) or ``"human"`` (sumo-gui over TraCI).
         **overrides: individual config fields, e.g. ``traffic_level=0.5``.
 
-    Reset options: ``command`` (fast|comfort|stop), ``traffic_level``, and
-    ``command_schedule`` [(time_s, command), ...]. See :mod:`explaindrive.env.state`
-    for the observation and :mod:`explaindrive.env.reward` for the rewards.
+    Reset options: ``command`` (fast|comfort|stop), ``traffic_level``,
+    ``command_schedule`` [(time_s, command), ...] and ``obs_noise`` (sd_m, sd_mps). See
+    :mod:`explaindrive.env.state` for the observation, :mod:`explaindrive.env.reward` for the
+    rewards and :mod:`explaindrive.env.noise` for the observation noise.
     """
 
     metadata = {"render_modes": ["human"], "render_fps": 1}  # noqa: RUF012
@@ -238,6 +243,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             start_pos_m=start_pos,
             pedestrians=PedestrianSource(int(sumo_seed), horizon_s=self.config.max_steps + 1.0),
             amber=AmberDecision(always=self.config.yellow_leader == "always"),
+            noise=opts.noise if opts.noise is not None else self.config.noise,
+            noise_rng=np.random.default_rng([int(sumo_seed), 17]),
         )
         self._apply_schedule(0.0)
         self._ep.pos_m = start_pos
@@ -251,6 +258,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             "time_s": 0.0,
             "distance_m": 0.0,
         }
+        if self._ep.noise.active:
+            info["true_obs"] = obs.copy()
         return self._output(obs), info
 
     def step(
@@ -283,12 +292,15 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             real=real, limit_mps=float(prev_obs[S.V_LIM]), red_run=red_run,
             ped_violation=ped_violation,
         )  # fmt: skip
-        terms = reward_terms(cmd, self._features(step))
+        terms = reward_terms(cmd, self._features(step), RECIPES[self.config.reward])
         terminated = motion.collided or motion.arrived
         truncated = not terminated and ep.steps >= self.config.max_steps
         ep.done = terminated or truncated
         self._last_obs = obs
-        return self._output(obs), terms.total, terminated, truncated, self._info(step, terms)
+        info = self._info(step, terms)
+        if ep.noise.active:
+            info["true_obs"] = obs.copy()
+        return self._output(obs), terms.total, terminated, truncated, info
 
     # ------------------------------------------------------------------ step pieces
     def _advance(self, ep: _Episode, change: int) -> _Motion:
@@ -343,6 +355,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         stop_reason: str | None = None
         if leader is not None and leader.gap_m <= STOP_REASON_GAP_M:
             stop_reason = "signal" if leader.virtual else "queue"
+        real = step.real
         return StepFeatures(
             speed_mps=v,
             speed_change_mps=step.change,
@@ -353,6 +366,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             violation=step.red_run or step.ped_violation,
             stop_reason=stop_reason,
             collided=step.motion.collided,
+            real_headway_s=time_headway(real.gap_m, real.length_m, v) if real else math.inf,
+            accel_mps2=step.accel,
+            leader_gap_m=leader.gap_m if leader else math.inf,
         )
 
     def _info(self, step: _Step, terms: RewardTerms) -> dict[str, Any]:
@@ -377,6 +393,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             "real_gap_m": real.gap_m if real else math.inf,
             "real_ttc_s": time_to_collision(real.gap_m, v - real.speed_mps) if real else math.inf,
             "real_headway_s": time_headway(real.gap_m, real.length_m, v) if real else math.inf,
+            "real_leader_speed_mps": real.speed_mps if real else math.inf,
+            "light_gap_m": float(self._last_obs[S.D_TL]),
+            "light_state": S.LightState(int(self._last_obs[S.TLS])).label,
+            "crossing_gap_m": float(self._last_obs[S.D_CROSS]),
             "distance_m": ep.pos_m - ep.start_pos_m,
             "collision": step.motion.collided,
             "red_light_run": step.red_run,
@@ -658,4 +678,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         return False
 
     def _output(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
-        return S.normalize(obs) if self.config.normalize_obs else obs.copy()
+        """What the driver sees: the observation with the episode's sensor noise."""
+        ep = self._ep
+        seen = ep.noise.apply(obs, ep.noise_rng) if ep is not None else obs.copy()
+        return S.normalize(seen) if self.config.normalize_obs else seen

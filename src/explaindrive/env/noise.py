@@ -1,0 +1,73 @@
+"""Sensor noise on the observation: what the driver sees is not the true state.
+
+Gaussian noise with standard deviation ``sd_m`` on the three distances (leader gap, next
+light, next busy crossing) and ``sd_mps`` on the two measured speeds (the ego's speed and
+the closing speed to the leader). The command, the posted limit and the light's colour are
+exact (the limit comes from the map, the colour is unambiguous). A distance at sensor range
+means "nothing detected" and stays so; noisy values are clipped to the state's bounds. The
+environment judges violations and computes rewards on the true state.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from explaindrive.env import state as S
+
+DISTANCE_INDICES = (S.D_LEAD, S.D_TL, S.D_CROSS)
+MAX_NOISE_SD_M = 20.0  # [m] largest accepted standard deviation on distances
+MAX_NOISE_SD_MPS = 5.0  # [m/s] largest accepted standard deviation on speeds
+
+
+@dataclass(frozen=True, slots=True)
+class ObservationNoise:
+    """Standard deviations of the noise on distances [m] and speeds [m/s]."""
+
+    sd_m: float = 0.0
+    sd_mps: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.sd_m <= MAX_NOISE_SD_M:
+            raise ValueError(f"distance noise must be in [0, {MAX_NOISE_SD_M}] m, got {self.sd_m}")
+        if not 0.0 <= self.sd_mps <= MAX_NOISE_SD_MPS:
+            raise ValueError(
+                f"speed noise must be in [0, {MAX_NOISE_SD_MPS}] m/s, got {self.sd_mps}"
+            )
+
+    @property
+    def active(self) -> bool:
+        """Whether any noise is added."""
+        return self.sd_m > 0.0 or self.sd_mps > 0.0
+
+    def apply(self, obs: NDArray[np.float32], rng: np.random.Generator) -> NDArray[np.float32]:
+        """A noisy copy of a raw observation (``obs`` is left as it is)."""
+        out = obs.astype(np.float32, copy=True)
+        if not self.active:
+            return out
+        draws = rng.standard_normal(5)
+        for k, i in enumerate(DISTANCE_INDICES):
+            if out[i] < S.SENSOR_RANGE_M:
+                out[i] = out[i] + self.sd_m * draws[k]
+        out[S.V_EGO] = out[S.V_EGO] + self.sd_mps * draws[3]
+        if out[S.D_LEAD] < S.SENSOR_RANGE_M:
+            out[S.DV] = out[S.DV] + self.sd_mps * draws[4]
+        return np.clip(out, S.STATE_LOW, S.STATE_HIGH).astype(np.float32)
+
+
+def parse_noise(text: str) -> ObservationNoise:
+    """``"SD_M,SD_MPS"`` (e.g. ``"2,0.6"``) as an :class:`ObservationNoise`.
+
+    Raises:
+        ValueError: naming the expected form or the range.
+    """
+    parts = text.split(",")
+    try:
+        sd_m, sd_mps = (float(p) for p in parts)
+    except ValueError:
+        raise ValueError(
+            f"observation noise must look like SD_M,SD_MPS (e.g. 2,0.6), got {text!r}"
+        ) from None
+    return ObservationNoise(sd_m, sd_mps)
