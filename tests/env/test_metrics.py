@@ -35,6 +35,14 @@ def info(
         "ped_violation": ped,
         "speeding": speeding,
         "arrived": arrived,
+        "accel_mps2": 0.0,
+        "posted_limit_mps": 13.89,
+        "real_gap_m": math.inf,
+        "gap_m": math.inf,
+        "leader_virtual": False,
+        "light_gap_m": 200.0,
+        "light_state": "green",
+        "crossing_gap_m": 200.0,
     }
 
 

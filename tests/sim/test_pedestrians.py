@@ -51,7 +51,8 @@ def sumo() -> FakeSumo:
         (95.0, 7.0, True),  # 5 m before the line, needs 7 m to stand still
         (90.0, 7.0, False),  # 10 m before: can stop, so the pedestrian walks
         (99.5, 0.0, False),  # standing 0.5 m before the line: the pedestrian walks
-        (101.0, 0.0, True),  # standing on the crossing
+        (101.0, 0.0, False),  # standing on the crossing: the pedestrian passes it
+        (101.0, 2.0, True),  # moving on the crossing
         (111.0, 9.0, True),  # front beyond, rear (111 - 5 = 106) still on it
         (112.0, 9.0, False),  # rear at the junction's end: clear
     ],

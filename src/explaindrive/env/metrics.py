@@ -19,6 +19,8 @@ Definitions:
                  misses its bound when it takes more than ceil(v/3) + 2 steps, v
                  being the speed when the command came
     travel time  seconds until the ego left the route (None if it did not)
+    ride         the ride-quality figures (free-road speed, hard brakes, reversals, jerk
+                 percentiles, standstill gaps): :mod:`explaindrive.env.ride_quality`
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 from typing import Any
+
+from explaindrive.env.ride_quality import RideQuality, RideQualityResult
 
 TTC_INTERACTION_S = 10.0  # [s] TTCs at or above this are not counted as interactions
 MOVING_SPEED_MPS = 1.0  # [m/s] headways are averaged over steps at or above this speed
@@ -50,6 +54,7 @@ class EpisodeResult:
     distance_m: float
     travel_time_s: float | None
     total_reward: float
+    ride: RideQualityResult = field(default_factory=lambda: RideQuality().result())
 
     @property
     def violations(self) -> int:
@@ -60,6 +65,7 @@ class EpisodeResult:
         """JSON-ready dict."""
         d = asdict(self)
         d["stop_latencies"] = list(self.stop_latencies)
+        d["ride"] = self.ride.as_dict()
         return d
 
 
@@ -89,6 +95,7 @@ class EpisodeMetrics:
     total_reward: float = 0.0
     _prev_command: str | None = None
     _unfinished: int = 0
+    ride: RideQuality = field(default_factory=RideQuality)
 
     def update(self, info: dict[str, Any], reward: float = 0.0) -> None:
         """Add one step's ``info`` (and reward)."""
@@ -110,6 +117,7 @@ class EpisodeMetrics:
         self.arrived = self.arrived or bool(info.get("arrived", False))
         self.total_reward += float(reward)
         self._track_stop(str(info["command"]), speed)
+        self.ride.update(info)
 
     def _track_stop(self, command: str, speed_mps: float) -> None:
         # ``command`` is the command under which this step's action was taken.
@@ -149,6 +157,7 @@ class EpisodeMetrics:
             distance_m=self.distance_m,
             travel_time_s=self.time_s if self.arrived else None,
             total_reward=self.total_reward,
+            ride=self.ride.result(),
         )
 
 

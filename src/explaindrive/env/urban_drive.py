@@ -45,6 +45,7 @@ from explaindrive.env.reward import (
     time_to_collision,
 )
 from explaindrive.sim.connection import SumoConnection
+from explaindrive.sim.crossing_lanes import CrossingLane, crossing_lanes, pedestrian_in_lane
 from explaindrive.sim.pedestrians import KerbYield, PedestrianSource
 from explaindrive.sim.route import RouteCrossing, RouteGeometry, load_route_geometry
 from explaindrive.sim.scenario.files import (
@@ -65,6 +66,7 @@ _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
+JUDGE_CROSSING_M = S.MAX_SPEED_MPS + 5.0  # [m] a crossing this close may be entered next step
 _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
 _HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
 
@@ -122,7 +124,7 @@ class _Episode:
     accel_mps2: float = 0.0
     pos_m: float = 0.0
     light_state: dict[str, S.LightState] = field(default_factory=dict)
-    occupied: dict[str, bool] = field(default_factory=dict)
+    occupied: dict[str, bool] = field(default_factory=dict)  # crossing -> ped in the ego's lane
     done: bool = False
     pedestrians: PedestrianSource | None = None
     kerb: KerbYield = field(default_factory=KerbYield)
@@ -170,6 +172,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         )
         self.scenario.check()
         self.geometry: RouteGeometry = load_route_geometry(self.scenario.net_file, EGO_ROUTE_EDGES)
+        self._crossing_lanes: dict[str, CrossingLane] = crossing_lanes(
+            self.scenario.net_file, _approach_edges(self.geometry)
+        )
         if cfg.normalize_obs:
             low, high = S.normalize(S.STATE_LOW), S.normalize(S.STATE_HIGH)
         else:
@@ -548,26 +553,36 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         res = self._conn.api.edge.getSubscriptionResults(edge)
         return tuple(res.get(tc.LAST_STEP_PERSON_ID_LIST, ()))
 
-    def _crossing_occupied(self, crossing: RouteCrossing, on_it: bool) -> tuple[bool, bool]:
-        """(busy, on_crossing): a pedestrian is on the crossing or, at a zebra, about to
-        step onto it; and whether one is on the crossing itself.
+    def _crossing_occupied(
+        self, crossing: RouteCrossing, on_it: bool, judge: bool = True
+    ) -> tuple[bool, bool]:
+        """(busy, in_lane): a pedestrian is on the crossing or, at a zebra, about to
+        step onto it; and whether one is in, or stepping into, the ego's lane on it
+        (looked at only with ``judge``: the ego is close enough to cross the line next).
 
         At a signalized crossing pedestrians waiting on the kerb wait for their own
         green, and once the ego is on the crossing (``on_it``) those on the kerb wait for
         it, so then only pedestrians already on the crossing count. At a zebra, those
         waiting for the ego (:class:`~explaindrive.sim.pedestrians.KerbYield`) do not.
         """
-        if self._persons(crossing.crossing_edge):
-            return True, True
+        on_crossing = self._persons(crossing.crossing_edge)
+        if on_crossing:
+            return True, judge and self._in_lane(crossing, on_crossing)
         if crossing.signalized or on_it:
             return False, False
         person, ep = self._conn.api.person, self._episode()
-        entering = any(
-            person.getNextEdge(pid) == crossing.crossing_edge and not ep.kerb.holds(pid)
+        entering = tuple(
+            pid
             for wa in crossing.walkingareas
             for pid in self._persons(wa)
+            if person.getNextEdge(pid) == crossing.crossing_edge and not ep.kerb.holds(pid)
         )
-        return entering, False
+        return bool(entering), judge and bool(entering) and self._in_lane(crossing, entering)
+
+    def _in_lane(self, crossing: RouteCrossing, persons: tuple[str, ...]) -> bool:
+        """Whether one of ``persons`` is in, or stepping into, the ego's lane on the crossing."""
+        lane = self._crossing_lanes[crossing.crossing_edge]
+        return any(pedestrian_in_lane(self._conn.api, lane, pid) for pid in persons)
 
     def _observe(
         self, api: Any, ego: Any
@@ -650,8 +665,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             # Relevant from sensor range until the ego's front has left the junction: a car
             # stopped on the crossing (e.g. by a STOP command) must not roll into pedestrians.
             if crossing.stop_line_m - crossing.end_m <= ahead < S.SENSOR_RANGE_M:
-                busy, on_crossing = self._crossing_occupied(crossing, on_it=ahead < 0.0)
-                ep.occupied[crossing.crossing_edge] = on_crossing
+                busy, in_lane = self._crossing_occupied(
+                    crossing, on_it=ahead < 0.0, judge=ahead < JUDGE_CROSSING_M
+                )
+                ep.occupied[crossing.crossing_edge] = in_lane
                 if busy:
                     d_cross = min(d_cross, max(ahead, 0.0))
         return d_cross
@@ -670,11 +687,14 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         return False
 
     def _violated_crossing(self, prev_pos: float, pos: float) -> bool:
+        """The ego's front crossed a crossing's stop line during this step while a
+        pedestrian was in, or stepping into, its lane (before or after the step)."""
         ep = self._episode()
         for crossing in self.geometry.crossings:
             if prev_pos < crossing.stop_line_m <= pos:
                 was = ep.occupied.get(crossing.crossing_edge, False)
-                return was or bool(self._persons(crossing.crossing_edge))
+                on_crossing = self._persons(crossing.crossing_edge)
+                return was or (bool(on_crossing) and self._in_lane(crossing, on_crossing))
         return False
 
     def _output(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
@@ -682,3 +702,13 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep = self._ep
         seen = ep.noise.apply(obs, ep.noise_rng) if ep is not None else obs.copy()
         return S.normalize(seen) if self.config.normalize_obs else seen
+
+
+def _approach_edges(geometry: RouteGeometry) -> dict[str, str]:
+    """Each crossing of the route -> the route edge that leads to it."""
+    out = {}
+    for crossing in geometry.crossings:
+        for i, edge in enumerate(geometry.edges[:-1]):
+            if abs(geometry.edge_start_m[i + 1] - crossing.end_m) < 1e-6:
+                out[crossing.crossing_edge] = edge
+    return out

@@ -8,6 +8,12 @@ Conventions (as in the paper's table, which averages over its 25 episodes):
     red-light / ped / speeding    totals over the episodes
     stop latency                  over every finished stop of every episode [steps]
     travel time                   mean over the episodes in which the ego reached the end [s]
+    ride quality                  pooled over the episodes' steps outside STOP: free-road
+                                  speed share and slow share over all free-road steps, hard
+                                  brakes per episode and per km, reversals per minute of
+                                  following, jerky-step share; p95 jerk is the mean of the
+                                  episodes' p95; standstill gaps over every stop of every
+                                  episode (definitions: :mod:`explaindrive.env.ride_quality`)
 """
 
 from __future__ import annotations
@@ -21,6 +27,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from explaindrive.env.metrics import EpisodeResult
+from explaindrive.env.reward import STOP_WINDOW_M
+from explaindrive.env.ride_quality import RideQualityResult
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,6 +57,18 @@ class Aggregate:
     stop_bound_misses: int
     arrived: int
     travel_time_mean_s: float | None
+    free_road_speed_share: float | None = None
+    slow_free_road_share: float | None = None
+    hard_brakes_per_episode: float = 0.0
+    hard_brakes_per_km: float = 0.0
+    reversals_per_min: float | None = None
+    jerk_p95_mps3: float = 0.0
+    jerky_share: float = 0.0
+    light_stops: int = 0
+    light_stop_gap_mean_m: float | None = None
+    crossing_stops: int = 0
+    crossing_stop_gap_mean_m: float | None = None
+    stop_gap_in_window_share: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict."""
@@ -109,7 +129,38 @@ def aggregate(results: Sequence[EpisodeResult]) -> Aggregate:
         stop_bound_misses=sum(r.stop_bound_misses for r in results),
         arrived=len(travel),
         travel_time_mean_s=mean(travel),
+        **ride_quality([r.ride for r in results], math.fsum(r.distance_m for r in results)),
     )
+
+
+def ride_quality(rides: Sequence[RideQualityResult], distance_m: float) -> dict[str, Any]:
+    """The ride-quality fields of :class:`Aggregate` (see the module docstring)."""
+    free = sum(r.free_road_steps for r in rides)
+    following = sum(r.following_steps for r in rides)
+    steps = sum(r.steps for r in rides)
+    brakes = sum(r.hard_brakes for r in rides)
+    lights = [g for r in rides for g in r.light_stop_gaps_m]
+    crossings = [g for r in rides for g in r.crossing_stop_gaps_m]
+    lo, hi = STOP_WINDOW_M
+    in_window = [lo <= g <= hi for g in lights + crossings]
+    return {
+        "free_road_speed_share": math.fsum(r.free_road_speed_sum for r in rides) / free
+        if free
+        else None,
+        "slow_free_road_share": sum(r.slow_free_road_steps for r in rides) / free if free else None,
+        "hard_brakes_per_episode": brakes / len(rides) if rides else 0.0,
+        "hard_brakes_per_km": brakes / (distance_m / 1000.0) if distance_m > 0 else 0.0,
+        "reversals_per_min": sum(r.reversals for r in rides) / (following / 60.0)
+        if following
+        else None,
+        "jerk_p95_mps3": math.fsum(r.jerk_p95_mps3 for r in rides) / len(rides) if rides else 0.0,
+        "jerky_share": sum(r.jerky_steps for r in rides) / steps if steps else 0.0,
+        "light_stops": len(lights),
+        "light_stop_gap_mean_m": mean(lights),
+        "crossing_stops": len(crossings),
+        "crossing_stop_gap_mean_m": mean(crossings),
+        "stop_gap_in_window_share": sum(in_window) / len(in_window) if in_window else None,
+    }
 
 
 def aggregate_by_level(

@@ -65,9 +65,11 @@ class KerbYield:
     approaching cars do. Traffic codes also bind pedestrians: none may step out in front of
     a vehicle so close that it cannot yield (e.g. the US Uniform Vehicle Code 11-502(b)).
     This class applies that rule to the ego: each step, the pedestrians about to step from
-    a walking area onto an unsignalized crossing stand still while the ego is on the
+    a walking area onto an unsignalized crossing stand still while the ego moves on the
     crossing or would need more than the distance left to stand still before its stop line;
-    they walk on at their own speed once it no longer holds.
+    they walk on at their own speed once it no longer holds. A car standing on the crossing
+    does not hold them: they pass it, and a car that waits for them (as SUMO's drivers do)
+    is not left waiting for pedestrians who wait for it.
     """
 
     def __init__(self) -> None:
@@ -113,11 +115,12 @@ class KerbYield:
 
 
 def _blocks(crossing: RouteCrossing, front_m: float, length_m: float, reach_m: float) -> bool:
-    """The ego is on the crossing, or approaches it and cannot stand still before it."""
-    if front_m - length_m >= crossing.end_m:
+    """The ego moves on the crossing, or approaches it and cannot stand still before it
+    (``reach_m`` is 0 for a car that stands still)."""
+    if front_m - length_m >= crossing.end_m or reach_m <= 0.0:
         return False
     ahead = crossing.stop_line_m - front_m
-    return ahead < 0.0 or ahead < reach_m
+    return ahead < reach_m
 
 
 def _entering(api: Any, crossing: RouteCrossing) -> list[str]:
