@@ -141,3 +141,10 @@ def test_policy_resolution(tmp_path: Path) -> None:
     (tmp_path / "run" / "policy.json").write_text('{"mode": "comfort"}')
     spec = parse_policy(str(tmp_path / "run"))
     assert (spec.name, spec.primary, spec.kind) == ("run", "comfort", "agent")
+
+
+def test_a_noisy_run_names_its_noise_and_every_episode_carries_it() -> None:
+    plan = plan_run(FAST, (0, 1), (0.5,), obs_noise=(2.0, 0.6))
+    assert plan.name == "fast, noise 2 m / 0.6 m/s"
+    assert {e.obs_noise for e in plan.episodes} == {(2.0, 0.6)}
+    assert plan_run(FAST, (0,), (0.5,)).episodes[0].obs_noise == (0.0, 0.0)

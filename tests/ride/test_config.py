@@ -50,6 +50,10 @@ from explaindrive.sim.scenario.layout import MAX_TRAFFIC_LEVEL, SEED_LIMIT
             "backend: unknown language backend 'gpt'; choose one of: embedded, openai",
         ),
         ({"realtime": 1}, "realtime: Input should be a valid boolean, got 1"),
+        (
+            {"obs_noise": (1.0, 9.0)},
+            "obs_noise: speed noise must be in [0, 5.0] m/s, got 9.0",
+        ),
     ],
 )
 def test_bad_settings_are_rejected(settings: dict[str, object], message: str) -> None:

@@ -37,7 +37,7 @@ from explaindrive.config import (
     read_yaml,
 )
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
-from explaindrive.env.noise import ObservationNoise
+from explaindrive.env.noise import NoiseSD
 from explaindrive.env.reward import REWARD_NAMES
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
@@ -142,7 +142,7 @@ class TrainConfig(ConfigModel):
     reward: Annotated[str, one_of(REWARD_NAMES)] = "paper"
     """The reward recipe (:mod:`explaindrive.env.reward`): ``paper`` (R0/R1/R2) or
     ``passenger`` (the same terms, weighted for a ride a passenger would choose)."""
-    obs_noise_max: Annotated[tuple[float, float], FROM_LIST] = (0.0, 0.0)
+    obs_noise_max: NoiseSD = (0.0, 0.0)
     """``(sd_m, sd_mps)``: each episode draws its observation noise uniformly between 0 and
     these (domain randomisation, :mod:`explaindrive.env.noise`); the safety masks of
     learning are computed on the true state."""
@@ -185,12 +185,6 @@ class TrainConfig(ConfigModel):
         if not 0 < lo <= hi:
             raise ValueError(f"must be [min, max] with 0 < min <= max, got {[lo, hi]}")
         return bounds
-
-    @field_validator("obs_noise_max")
-    @classmethod
-    def _noise_in_range(cls, value: tuple[float, float]) -> tuple[float, float]:
-        ObservationNoise(*value)  # raises ValueError naming the range
-        return value
 
     @model_validator(mode="after")
     def _batch_fits_buffer(self) -> TrainConfig:

@@ -35,6 +35,14 @@ CommandsOption = Annotated[
 FiguresOption = Annotated[
     Path | None, typer.Option("--figures", help="Write PNG figures into this directory.")
 ]
+ObsNoiseOption = Annotated[
+    str | None,
+    typer.Option(
+        "--obs-noise",
+        help="Sensor noise SD_M,SD_MPS on the distances and speeds the policy and its shield "
+        "see (e.g. 2,0.6); violations are judged on the true state.",
+    ),
+]
 EpisodesOption = Annotated[
     bool, typer.Option("--episodes/--no-episodes", help="Also print one row per episode.")
 ]
@@ -56,11 +64,12 @@ def evaluate_command(
     comfort_policy: grid.ComfortPolicyOption = None,
     shield: grid.ShieldOption = True,
     episodes: EpisodesOption = True,
+    obs_noise: ObsNoiseOption = None,
 ) -> None:
     """Evaluate a policy or a SUMO baseline; prints Markdown tables in the paper's layout."""
+    from explaindrive.env.noise import parse_noise
     from explaindrive.evaluation.schema import run_document, write_json
     from explaindrive.evaluation.spec import (
-        SpecError,
         parse_levels,
         parse_policy,
         parse_seeds,
@@ -71,11 +80,13 @@ def evaluate_command(
         spec = parse_policy(
             policy, fast_path=fast_policy, comfort_path=comfort_policy, shield=shield
         )
+        noise = parse_noise(obs_noise) if obs_noise is not None else None
         plan = plan_run(
             spec, parse_seeds(seeds), parse_levels(traffic),
             stop_schedule=stop_schedule, commands=commands, max_steps=max_steps,
+            obs_noise=(noise.sd_m, noise.sd_mps) if noise else (0.0, 0.0),
         )  # fmt: skip
-    except SpecError as exc:
+    except ValueError as exc:
         err_console.print(error_line(exc))
         raise typer.Exit(2) from None
     if (problem := grid.check_ray_target(ray, ray_address)) is not None:
@@ -116,6 +127,7 @@ def _print_tables(name: str, spec: PolicySpec, records: list[Any], episodes: boo
     out.print(tables.paper_table([summary]) + "\n")
     out.print(tables.level_table([summary]) + "\n")
     out.print(tables.safety_table([summary]) + "\n")
+    out.print(tables.ride_table([summary]) + "\n")
     if spec.kind != "baseline":
         overrides, steps = shield_counts(records)
         out.print(tables.shield_line(overrides, steps, spec.shield) + "\n")

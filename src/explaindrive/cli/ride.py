@@ -71,6 +71,10 @@ TrafficOption = Annotated[float, typer.Option("--traffic", help="Traffic level (
 SeedOption = Annotated[int, typer.Option("--seed", help="Simulation seed.")]
 MaxStepsOption = Annotated[int, typer.Option("--max-steps", help="Longest ride [s].")]
 GuiOption = Annotated[bool, typer.Option("--gui", help="Show the ride in sumo-gui.")]
+ObsNoiseOption = Annotated[
+    str | None,
+    typer.Option("--obs-noise", help="Sensor noise SD_M,SD_MPS on what the driver sees."),
+]
 RealtimeOption = Annotated[bool, typer.Option("--realtime", help="One step per second.")]
 # What the ride leaves behind, and the terminal view
 OutOption = Annotated[Path, typer.Option("--out", help="Output directory (empty or new).")]
@@ -78,6 +82,16 @@ ForceOption = Annotated[
     bool, typer.Option("--force", help="Replace the ride already in --out instead of refusing.")
 ]
 LiveOption = Annotated[bool, typer.Option("--live/--no-live", help="Live terminal view.")]
+
+
+def _noise(text: str | None) -> tuple[float, float]:
+    """``--obs-noise`` as ``(sd_m, sd_mps)``; ValueError naming the expected form."""
+    if text is None:
+        return (0.0, 0.0)
+    from explaindrive.env.noise import parse_noise
+
+    noise = parse_noise(text)
+    return (noise.sd_m, noise.sd_mps)
 
 
 def ride(
@@ -98,6 +112,7 @@ def ride(
     live: LiveOption = True,
     fast_policy: FastPolicyOption = None,
     comfort_policy: ComfortPolicyOption = None,
+    obs_noise: ObsNoiseOption = None,
 ) -> None:
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     if voice and not interactive:
@@ -115,6 +130,7 @@ def ride(
             gui=gui,
             fast_policy=fast_policy,
             comfort_policy=comfort_policy,
+            obs_noise=_noise(obs_noise),
         )
         language_config = LanguageConfig()
         lines = _script_lines(script, interactive, max_steps)

@@ -11,10 +11,13 @@ environment judges violations and computes rewards on the true state.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
 from numpy.typing import NDArray
+from pydantic import AfterValidator
 
+from explaindrive.config import FROM_LIST
 from explaindrive.env import state as S
 
 DISTANCE_INDICES = (S.D_LEAD, S.D_TL, S.D_CROSS)
@@ -71,3 +74,12 @@ def parse_noise(text: str) -> ObservationNoise:
             f"observation noise must look like SD_M,SD_MPS (e.g. 2,0.6), got {text!r}"
         ) from None
     return ObservationNoise(sd_m, sd_mps)
+
+
+def _check_sd(value: tuple[float, float]) -> tuple[float, float]:
+    ObservationNoise(*value)  # raises ValueError naming the range
+    return value
+
+
+NoiseSD = Annotated[tuple[float, float], FROM_LIST, AfterValidator(_check_sd)]
+"""A config field holding ``(sd_m, sd_mps)``, checked against the accepted ranges."""

@@ -80,6 +80,8 @@ class EpisodeSpec:
         command: command from the first step (label).
         schedule: ``(time_s, command label)`` switches after the start.
         max_steps: step limit [steps of 1 s].
+        obs_noise: ``(sd_m, sd_mps)`` of the noise on what the driver sees
+            (:mod:`explaindrive.env.noise`); SUMO's drivers see the true state.
     """
 
     policy: PolicySpec
@@ -88,6 +90,7 @@ class EpisodeSpec:
     command: str
     schedule: tuple[tuple[float, str], ...]
     max_steps: int = DEFAULT_MAX_STEPS
+    obs_noise: tuple[float, float] = (0.0, 0.0)
 
 
 # ---------------------------------------------------------------------------- text parsers
@@ -347,6 +350,7 @@ def build_grid(
     command: str | None = None,
     schedule: Sequence[tuple[float, str]] = (),
     max_steps: int = DEFAULT_MAX_STEPS,
+    obs_noise: tuple[float, float] = (0.0, 0.0),
 ) -> tuple[EpisodeSpec, ...]:
     """Every (traffic level, seed) episode, level-major, in the given order.
 
@@ -361,7 +365,7 @@ def build_grid(
     sched = tuple((float(t), Command.parse(c).label) for t, c in schedule)
     check_schedule(policy, first, sched)
     return tuple(
-        EpisodeSpec(policy, int(seed), float(level), first, sched, max_steps)
+        EpisodeSpec(policy, int(seed), float(level), first, sched, max_steps, obs_noise)
         for level in levels
         for seed in seeds
     )
@@ -392,6 +396,7 @@ def plan_run(
     commands: str | None = None,
     max_steps: int = DEFAULT_MAX_STEPS,
     name: str | None = None,
+    obs_noise: tuple[float, float] = (0.0, 0.0),
 ) -> RunPlan:
     """Build a run from parsed seeds/levels and the schedule texts of the CLI.
 
@@ -420,6 +425,8 @@ def plan_run(
         intervals = tuple((s, e) for c, s, e in segments if c == Command.STOP.label)
         if policy.kind != "merged" or commands != PAPER_MERGED_COMMANDS:
             label = f"{policy.name} ({commands})"
+    if obs_noise != (0.0, 0.0):
+        label = f"{label}, noise {obs_noise[0]:g} m / {obs_noise[1]:g} m/s"
     episodes = build_grid(policy, seeds, levels, command=first, schedule=schedule,
-                          max_steps=max_steps)  # fmt: skip
+                          max_steps=max_steps, obs_noise=obs_noise)  # fmt: skip
     return RunPlan(name or label, episodes, intervals)

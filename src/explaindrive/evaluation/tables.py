@@ -111,6 +111,32 @@ def safety_table(summaries: Sequence[RunSummary]) -> str:
     return markdown_table(header, rows)
 
 
+def ride_table(summaries: Sequence[RunSummary]) -> str:
+    """What a passenger feels, outside STOP (definitions: ``env/ride_quality.py``)."""
+    header = [
+        "policy", "mean speed m/s", "free-road speed (share of limit)", "free road < 60 %",
+        "hard brakes /episode", "hard brakes /km", "reversals /min following",
+        "p95 abs(jerk) m/s^3", "steps abs(jerk) >= 3", "standstill before line: light / crossing m",
+        "stops 1-5 m from line", "travel time s",
+    ]  # fmt: skip
+    rows = []
+    for s in summaries:
+        o = s.overall
+        rows.append([
+            s.name, fmt(o.mean_speed_mps), _pct(o.free_road_speed_share),
+            _pct(o.slow_free_road_share), fmt(o.hard_brakes_per_episode, 2),
+            fmt(o.hard_brakes_per_km, 2), fmt(o.reversals_per_min, 2), fmt(o.jerk_p95_mps3, 2),
+            _pct(o.jerky_share),
+            f"{fmt(o.light_stop_gap_mean_m, 1)} / {fmt(o.crossing_stop_gap_mean_m, 1)}",
+            _pct(o.stop_gap_in_window_share), fmt(o.travel_time_mean_s, 1),
+        ])  # fmt: skip
+    return markdown_table(header, rows)
+
+
+def _pct(share: float | None) -> str:
+    return DASH if share is None else f"{100 * share:.1f} %"
+
+
 def episode_table(rows: Sequence[tuple[int, float, EpisodeResult]]) -> str:
     """One line per episode: ``(seed, traffic level, result)``."""
     header = [

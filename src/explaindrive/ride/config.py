@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import AfterValidator, NonNegativeFloat, PositiveInt
+from pydantic import AfterValidator, Field, NonNegativeFloat, PositiveInt
 
 from explaindrive.config import ConfigModel, Seed, TextPath, TrafficLevel
+from explaindrive.env.noise import NoiseSD
 from explaindrive.language.backends import check_backend
 
 
@@ -31,6 +32,8 @@ class RideConfig(ConfigModel):
         fast_policy: the fast network ``explaindrive ride`` loads instead of the shipped
             one (a policy ``.pt`` file or a training run directory); kept in the summary.
         comfort_policy: likewise for the comfort network.
+        obs_noise: ``(sd_m, sd_mps)``: sensor noise on what the driver sees
+            (:mod:`explaindrive.env.noise`).
     """
 
     config_name = "ride config"
@@ -49,3 +52,4 @@ class RideConfig(ConfigModel):
     gui: bool = False
     fast_policy: TextPath | None = None
     comfort_policy: TextPath | None = None
+    obs_noise: NoiseSD = Field(default=(0.0, 0.0))
