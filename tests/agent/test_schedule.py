@@ -44,13 +44,17 @@ def test_seed_pool_bounds_the_episode_seeds() -> None:
 
 
 def test_observation_noise_is_drawn_per_episode_within_its_bounds() -> None:
-    cfg = PAPER.replace(obs_noise_max=(3.0, 0.9))
-    plans = [plan_episode(cfg, i) for i in range(40)]
-    noises = {p.obs_noise for p in plans}
-    assert len(noises) == 40
-    assert all(0.0 <= m <= 3.0 and 0.0 <= s <= 0.9 for m, s in noises)
+    cfg = PAPER.replace(obs_noise_max=(3.0, 0.9), noisy_share=0.5)
+    plans = [plan_episode(cfg, i) for i in range(200)]
+    noisy = [p for p in plans if p.obs_noise != (0.0, 0.0)]
+    assert 80 <= len(noisy) <= 120  # about half
+    assert len({p.obs_noise for p in noisy}) == len(noisy)
+    assert all(0.0 <= m <= 3.0 and 0.0 <= s <= 0.9 for m, s in (p.obs_noise for p in noisy))
     assert plan_episode(cfg, 7) == plans[7]
-    assert plans[0].reset_options()["obs_noise"] == list(plans[0].obs_noise)
+    assert noisy[0].reset_options()["obs_noise"] == list(noisy[0].obs_noise)
+    assert all(p.obs_noise == (0.0, 0.0) for p in map(
+        lambda i: plan_episode(cfg.replace(noisy_share=0.0), i), range(20)
+    ))  # fmt: skip
     # the noise has its own generator: the rest of the plan is the one without noise
     plain = plan_episode(PAPER, 7)
     assert (plain.seed, plain.traffic_level, plain.command_schedule) == (

@@ -120,6 +120,7 @@ def test_stop_reward_terms_only_hold_the_stop_term():
         "stop": -50.0,
         "time": 0.0,
         "brake": 0.0,
+        "approach": 0.0,
         "total": -50.0,
     }
 
@@ -133,16 +134,27 @@ def test_hard_brake_penalty_charges_braking_beyond_one_mps2():
 
 def test_passenger_fast_terms():
     # braking at -3 m/s per step while closing in on a stop line (a virtual leader)
-    f = _features(speed_change_mps=-3, accel_mps2=-3.0, leader_gap_m=10.0)
+    f = _features(speed_change_mps=-3, accel_mps2=-3.0, leader_gap_m=10.0, closing_speed_mps=10.0)
     t = R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE)
     assert t.ttc == pytest.approx(2 * -0.693147, abs=1e-6)
     assert t.headway == 0.0  # no real leader: a stop line earns no headway reward
     assert t.jerk == pytest.approx(-0.1 * 4)
     assert t.speed == pytest.approx(3 * 10 / 13.89)
     assert t.time == -0.5
-    assert t.brake == -1.0
-    # -1.386294 - 0.4 + 2.159827 - 0.5 - 1.0 = -1.126467
-    assert t.total == pytest.approx(-1.126467, abs=1e-5)
+    assert t.brake == -2.0  # 0.5 * (3 - 1)^2
+    # stopping 10 m/s within 10 - 2 m needs 100 / 16 = 6.25 m/s^2: 0.3 * 4.75^2 = 6.76875
+    assert t.approach == pytest.approx(-6.76875)
+    # -1.386294 - 0.4 + 2.159827 - 0.5 - 2.0 - 6.76875 = -8.895217
+    assert t.total == pytest.approx(-8.895217, abs=1e-5)
+
+
+def test_needed_deceleration():
+    assert R.needed_deceleration(27.0, 10.0) == 2.0  # 100 / (2 * 25)
+    assert R.needed_deceleration(2.0, 3.0) == 9.0  # the room is floored at 0.5 m
+    assert R.needed_deceleration(50.0, -2.0) == 0.0  # opening the gap
+    assert R.needed_deceleration(math.inf, 5.0) == 0.0  # nothing ahead
+    assert R.approach_penalty(27.0, 10.0, 1.0) == -0.25  # (2 - 1.5)^2
+    assert R.approach_penalty(100.0, 10.0, 1.0) == 0.0  # 0.51 m/s^2: gentle enough
 
 
 def test_passenger_headway_pays_for_a_real_leader():
@@ -155,7 +167,7 @@ def test_passenger_headway_pays_for_a_real_leader():
 
 @pytest.mark.parametrize(
     ("gap_m", "paper", "passenger"),
-    [(3.0, 2.0, 1.0), (1.0, 2.0, 1.0), (5.0, 2.0, 1.0), (8.0, 2.0, 0.0), (0.5, 2.0, 0.0)],
+    [(3.0, 2.0, 2.0), (1.0, 2.0, 2.0), (5.0, 2.0, 2.0), (8.0, 2.0, 0.0), (0.5, 2.0, 0.0)],
 )
 def test_standing_for_a_signal_pays_only_near_the_line(gap_m, paper, passenger):
     f = _features(

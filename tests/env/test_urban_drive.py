@@ -208,6 +208,7 @@ def test_info_carries_the_reward_terms(make_env):
         "stop",
         "time",
         "brake",
+        "approach",
         "total",
     }
     assert terms["total"] == pytest.approx(reward)

@@ -143,9 +143,11 @@ class TrainConfig(ConfigModel):
     """The reward recipe (:mod:`explaindrive.env.reward`): ``paper`` (R0/R1/R2) or
     ``passenger`` (the same terms, weighted for a ride a passenger would choose)."""
     obs_noise_max: NoiseSD = (0.0, 0.0)
-    """``(sd_m, sd_mps)``: each episode draws its observation noise uniformly between 0 and
-    these (domain randomisation, :mod:`explaindrive.env.noise`); the safety masks of
-    learning are computed on the true state."""
+    """``(sd_m, sd_mps)``: a share ``noisy_share`` of the episodes draws its observation noise
+    uniformly between 0 and these (domain randomisation, :mod:`explaindrive.env.noise`);
+    the safety masks of learning are computed on the true state."""
+    noisy_share: Fraction = 0.5
+    """Share of the episodes with observation noise (when ``obs_noise_max`` is not zero)."""
     dilemma_braking: bool = True
     """Whether the safety mask of learning leaves braking in a yellow light's dilemma zone
     (where even the hardest braking cannot stop before the line) to the rewards; ``False``
@@ -245,9 +247,9 @@ PASSENGER = SAFE.replace(
     obs_noise_max=(3.0, 0.9),
     stop_when_safe=None,
 )
-"""The default: ``safe``'s learning with the ``passenger`` reward recipe, observation noise
-drawn per episode up to 3 m / 0.9 m/s, and every episode trained (no early end: a run that
-is safe early still has to learn to drive well)."""
+"""The default: ``safe``'s learning with the ``passenger`` reward recipe, observation noise up
+to 3 m / 0.9 m/s drawn in half of the episodes, and every episode trained (no early end: a
+run that is safe early still has to learn to drive well)."""
 
 PRESETS: dict[str, TrainConfig] = {"paper": PAPER, "safe": SAFE, "passenger": PASSENGER}
 DEFAULT_PRESET = "passenger"

@@ -89,9 +89,10 @@ def plan_episode(config: TrainConfig, index: int) -> EpisodePlan:
     noise = (0.0, 0.0)
     if config.obs_noise_max != (0.0, 0.0):
         # a generator of its own: the plans of runs without noise stay as they were
-        u = np.random.default_rng([config.seed, index, 11]).uniform(size=2)
-        noise = (
-            round(float(u[0]) * config.obs_noise_max[0], 3),
-            round(float(u[1]) * config.obs_noise_max[1], 3),
-        )
+        u = np.random.default_rng([config.seed, index, 11]).uniform(size=3)
+        if u[2] < config.noisy_share:
+            noise = (
+                round(float(u[0]) * config.obs_noise_max[0], 3),
+                round(float(u[1]) * config.obs_noise_max[1], 3),
+            )
     return EpisodePlan(index, seed, level, primary, schedule, noise)

@@ -15,6 +15,9 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
   driving (``signal_stop``, ``stop_window_m``);
 * jerk is charged under fast too (lightly), and braking harder than 1 m/s^2 is charged
   (``hard_brake``), more under comfort;
+* closing in on a leader, a red light or a pedestrian too fast to stop gently is charged
+  (``approach``): the deceleration that would just stop in time, as IDM's braking
+  strategy has it, beyond a comfortable 1.5 m/s^2, so the car slows down early;
 * comfort's progress is worth as much as fast's: the two differ in smoothness.
 """
 
@@ -40,6 +43,8 @@ FAST_SPEED_WEIGHT = 3.0
 COMFORT_SPEED_WEIGHT = 1.5
 STOP_REASON_GAP_M = 15.0  # [m] a leader this close justifies standing still
 GENTLE_BRAKE_MPS2 = 1.0  # [m/s^2] braking up to this is not charged by ``hard_brake``
+COMFORT_DECEL_MPS2 = 1.5  # [m/s^2] a stop needing up to this is not charged by ``approach``
+APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,6 +60,8 @@ class RewardWeights:
         time: charge per step [reward/s].
         jerk: weight of -jerk^2.
         hard_brake: weight of -(braking beyond :data:`GENTLE_BRAKE_MPS2`)^2.
+        approach: weight of -(needed deceleration beyond :data:`COMFORT_DECEL_MPS2`)^2
+            (:func:`approach_penalty`).
         signal_stop: paid per step standing for a light or a pedestrian.
         stop_window_m: ``(min, max)`` distance to the line within which ``signal_stop`` is
             paid; ``None`` pays it at any distance (the paper).
@@ -67,6 +74,7 @@ class RewardWeights:
     time: float = 0.0
     jerk: float = 0.0
     hard_brake: float = 0.0
+    approach: float = 0.0
     signal_stop: float = R_RESPECT
     stop_window_m: tuple[float, float] | None = None
 
@@ -106,8 +114,9 @@ PASSENGER_RECIPE = RewardRecipe(
         speed=FAST_SPEED_WEIGHT,
         time=0.5,
         jerk=0.1,
-        hard_brake=0.25,
-        signal_stop=1.0,
+        hard_brake=0.5,
+        approach=0.3,
+        signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
     ),
     comfort=RewardWeights(
@@ -116,8 +125,9 @@ PASSENGER_RECIPE = RewardRecipe(
         speed=FAST_SPEED_WEIGHT,
         time=0.5,
         jerk=1.0,
-        hard_brake=0.5,
-        signal_stop=1.0,
+        hard_brake=1.0,
+        approach=1.0,
+        signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
     ),
 )
@@ -200,6 +210,22 @@ def hard_brake_penalty(accel_mps2: float, weight: float) -> float:
     return -weight * excess * excess
 
 
+def needed_deceleration(gap_m: float, closing_speed_mps: float) -> float:
+    """The constant deceleration [m/s^2] that just stops the closing-in before the gap
+    shrinks to :data:`APPROACH_STANDSTILL_M`: dv^2 / (2 (gap - s0)) (IDM's kinematic
+    deceleration); 0 when not closing in, and the gap floored at 0.5 m."""
+    if closing_speed_mps <= 0.0 or not math.isfinite(gap_m):
+        return 0.0
+    room = max(gap_m - APPROACH_STANDSTILL_M, 0.5)
+    return closing_speed_mps * closing_speed_mps / (2.0 * room)
+
+
+def approach_penalty(gap_m: float, closing_speed_mps: float, weight: float) -> float:
+    """-weight * (needed deceleration beyond :data:`COMFORT_DECEL_MPS2`)^2."""
+    excess = max(0.0, needed_deceleration(gap_m, closing_speed_mps) - COMFORT_DECEL_MPS2)
+    return -weight * excess * excess
+
+
 def collision_reward(collided: bool) -> float:
     """-r_critical on a collision."""
     return -R_CRITICAL if collided else 0.0
@@ -230,6 +256,7 @@ class StepFeatures:
     real_headway_s: float = math.inf  # w.r.t. the real leader (inf without one)
     accel_mps2: float | None = None  # the step's speed change as driven; None: the action's
     leader_gap_m: float = math.inf  # gap to the effective leader after the step [m]
+    closing_speed_mps: float = 0.0  # ego speed minus the effective leader's, after the step
 
 
 @dataclass(frozen=True, slots=True)
@@ -245,13 +272,14 @@ class RewardTerms:
     stop: float = 0.0
     time: float = 0.0
     brake: float = 0.0
+    approach: float = 0.0
 
     @property
     def total(self) -> float:
         """Sum of the terms."""
         return math.fsum(
             (self.ttc, self.headway, self.jerk, self.traffic, self.speed, self.collision,
-             self.stop, self.time, self.brake)
+             self.stop, self.time, self.brake, self.approach)
         )  # fmt: skip
 
     def as_dict(self) -> dict[str, float]:
@@ -266,6 +294,7 @@ class RewardTerms:
             "stop": self.stop,
             "time": self.time,
             "brake": self.brake,
+            "approach": self.approach,
             "total": self.total,
         }
 
@@ -301,4 +330,5 @@ def reward_terms(
         collision=collision_reward(f.collided),
         time=-w.time,
         brake=hard_brake_penalty(accel, w.hard_brake),
+        approach=approach_penalty(f.leader_gap_m, f.closing_speed_mps, w.approach),
     )

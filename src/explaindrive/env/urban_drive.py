@@ -374,6 +374,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             real_headway_s=time_headway(real.gap_m, real.length_m, v) if real else math.inf,
             accel_mps2=step.accel,
             leader_gap_m=leader.gap_m if leader else math.inf,
+            closing_speed_mps=v - leader.speed_mps if leader else 0.0,
         )
 
     def _info(self, step: _Step, terms: RewardTerms) -> dict[str, Any]:
