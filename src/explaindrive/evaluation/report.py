@@ -329,7 +329,22 @@ def _result_tables(plan: ReportPlan, summaries: Mapping[str, RunSummary]) -> lis
     plain = [summaries[n] for n in plan.policies if n in summaries]
     agents = [summaries[n] for n in plan.policies if n in AGENTS and n in summaries]
     stop_runs = [s for name, s in summaries.items() if name.endswith("+ stops")]
-    lines = ["## The paper's table", "", tables.paper_table(plain), ""]
+    lines = [
+        "## Ride quality (outside STOP)",
+        "",
+        tables.ride_table(grid),
+        "",
+        "What a passenger feels, the same definitions for every driver "
+        "(`src/explaindrive/env/ride_quality.py`): free road has no vehicle within 50 m and "
+        "no red or yellow light or busy crossing within 60 m; a hard brake is a 1 s step "
+        "braking at 3 m/s^2 or more; a reversal is an acceleration of at least 2 m/s^2 "
+        "against the previous one while following a vehicle within 50 m.",
+        "",
+        "## The paper's table",
+        "",
+        tables.paper_table(plain),
+        "",
+    ]
     if agents:
         lines += ["## Per traffic level (paper in parentheses)", "",
                   tables.level_table(agents), ""]  # fmt: skip
