@@ -51,9 +51,9 @@ from explaindrive.sim.scenario.files import (
     EGO_ROUTE_ID,
     EGO_TYPE_ID,
     ScenarioFiles,
-    default_scenario,
 )
-from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES, SEED_LIMIT, validate_seed
+from explaindrive.sim.scenario.limits import SEED_LIMIT, validate_seed
+from explaindrive.sim.scenario.source import ScenarioSource
 from explaindrive.sim.sumo_home import sumo_binary
 
 log = logging.getLogger(__name__)
@@ -63,6 +63,7 @@ _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
+STRATEGIC_LANE_CHANGES = 0b011000000001  # SUMO lane-change mode: strategic changes only
 _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
 _HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
 
@@ -157,14 +158,14 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             cfg = EnvConfig.from_mapping({**dict(config or {}), **overrides})
         self.config = cfg
         self.render_mode = render_mode
-        cache = cfg.cache_dir or user_cache_dir()
-        self.scenario: ScenarioFiles = (
-            ScenarioFiles(net_file=cfg.net_file, cache_dir=cache)
-            if cfg.net_file
-            else default_scenario(cache)
+        self._scenarios = ScenarioSource(
+            cfg.cache_dir or user_cache_dir(), cfg.scenario, cfg.net_file, cfg.route,
+            cfg.demand_file, cfg.scenario_every,
+        )  # fmt: skip
+        self.scenario: ScenarioFiles = self._scenarios.current
+        self.geometry: RouteGeometry = load_route_geometry(
+            self.scenario.net_file, self.scenario.route_edges
         )
-        self.scenario.check()
-        self.geometry: RouteGeometry = load_route_geometry(self.scenario.net_file, EGO_ROUTE_EDGES)
         if cfg.normalize_obs:
             low, high = S.normalize(S.STATE_LOW), S.normalize(S.STATE_HIGH)
         else:
@@ -224,6 +225,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         level = opts.traffic_level if opts.traffic_level is not None else self.config.traffic_level
         sumo_seed = seed if seed is not None else int(self.np_random.integers(0, SEED_LIMIT - 1))
         validate_seed(sumo_seed)
+        self._use_scenario(self._scenarios.for_episode(int(sumo_seed)))
         try:
             self._conn.start_or_load(self._sumo_args(level, int(sumo_seed)))
             self._restore_warm_state(level, int(sumo_seed))
@@ -236,7 +238,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             command=opts.command,
             schedule=schedule,
             start_pos_m=start_pos,
-            pedestrians=PedestrianSource(int(sumo_seed), horizon_s=self.config.max_steps + 1.0),
+            pedestrians=PedestrianSource(
+                int(sumo_seed), self.config.max_steps + 1.0, self.scenario.pedestrian_flows
+            ),
             amber=AmberDecision(always=self.config.yellow_leader == "always"),
         )
         self._apply_schedule(0.0)
@@ -245,6 +249,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         obs, _leader, _ = self._observe(api, api.vehicle.getSubscriptionResults(EGO_ID))
         self._last_obs = obs
         info = {
+            "scenario": self.scenario.name,
             "command": self._ep.command.label,
             "traffic_level": level,
             "seed": int(sumo_seed),
@@ -397,12 +402,22 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise RuntimeError("no episode is running; call reset() first")
         return self._ep
 
+    def _use_scenario(self, scenario: ScenarioFiles) -> None:
+        """Drive the next episodes in ``scenario`` (a new draw under domain randomisation)."""
+        if scenario is self.scenario:
+            return
+        self.scenario = scenario
+        self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges)
+        self._tls_link = {}
+        self._conn.close()  # the next episode starts SUMO on the new network
+
     def _sumo_args(self, level: float, seed: int) -> list[str]:
         return [
             "-n",
             str(self.scenario.net_file),
             "-r",
-            str(self.scenario.routes_file(level)),
+            ",".join(str(p) for p in self.scenario.routes_files(level)),
+            *self.scenario.demand_args(level),
             "--seed",
             str(seed),
             "--step-length",
@@ -424,7 +439,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ]
 
     def _state_file(self, level: float, seed: int) -> Path:
-        demand = self.scenario.routes_file(level).name.removesuffix(".rou.xml")  # level + hash
+        demand = self.scenario.demand_key(level)  # level + hash
         return self.scenario.state_dir() / f"{demand}_seed{seed}_warm{self.config.warmup_s}.xml"
 
     def _restore_warm_state(self, level: float, seed: int) -> None:
@@ -445,12 +460,13 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".xml")
         os.close(fd)
-        warmup = str(self.config.warmup_s)
+        begin = self.scenario.begin_s
+        warmup = f"{begin + self.config.warmup_s:g}"
         args = [
             sumo_binary("sumo"),
             *self._sumo_args(level, seed),
             "--end",
-            str(self.config.warmup_s + 1),
+            f"{begin + self.config.warmup_s + 1:g}",
             "--save-state.times",
             warmup,
             "--save-state.files",
@@ -486,7 +502,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
                 f"the ego could not enter within {self.config.insert_timeout_s} s "
                 "(the first road stays blocked); lower the traffic level"
             )
-        api.vehicle.setLaneChangeMode(EGO_ID, 0)
+        lane_changes = STRATEGIC_LANE_CHANGES if self.scenario.strategic_lane_changes else 0
+        api.vehicle.setLaneChangeMode(EGO_ID, lane_changes)
         self._ego_min_gap_m = float(api.vehicle.getMinGap(EGO_ID))
         self._ego_length_m = float(api.vehicle.getLength(EGO_ID))
         if model == "agent":
@@ -506,8 +523,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     def _clear_entry(self) -> None:
         """Remove background vehicles from the ego's entry stretch (oversaturated demand)."""
         api = self._conn.api
-        lane = f"{EGO_ROUTE_EDGES[0]}_1"
-        for vid in api.lane.getLastStepVehicleIDs(lane):
+        edge = self.scenario.route_edges[0]
+        lanes = [f"{edge}_{i}" for i in range(api.edge.getLaneNumber(edge))]
+        for vid in (v for lane in lanes for v in api.lane.getLastStepVehicleIDs(lane)):
             if vid != EGO_ID and api.vehicle.getLanePosition(vid) < ENTRY_CLEAR_M:
                 api.vehicle.remove(vid)
         log.debug("cleared the ego's entry stretch after %d s without a gap", ENTRY_CLEAR_AFTER_S)

@@ -155,9 +155,10 @@ def make_layout(params: ScenarioParams) -> Layout:
         Flow("j2_north_south", ("J2N", "J2", "J2S"), d.j2_cross),
     )
     zebra, j2 = params.zebra_peds_per_hour, params.j2_peds_per_hour
-    # pedestrians at J2 start 150 m before the junction, at most halfway along the block
-    j2_depart = min(150.0, params.zone_end_to_j2_m / 2)
-    j2_arrival = min(50.0, params.exit_m / 2)
+    # pedestrians at J2 walk along the block Z2-J2 from 150 m (at most 3/4 of it) to 50 m
+    # (at most half of it) along the edge they start and end on
+    j2_depart = min(150.0, 0.75 * params.zone_end_to_j2_m)
+    j2_arrival = min(50.0, params.zone_end_to_j2_m / 2)
     peds = (
         PedestrianFlow("zebra_northbound", "PXS_PX", "PX_PXN", zebra, 5.0, 20.0),
         PedestrianFlow("zebra_southbound", "PXN_PX", "PX_PXS", zebra, 5.0, 20.0),
