@@ -5,15 +5,16 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Annotated, Any
 
-from pydantic import NonNegativeInt, PositiveInt, model_validator
+from pydantic import NonNegativeInt, PositiveInt
 
-from explaindrive.config import FROM_LIST, ConfigModel, TextPath, TrafficLevel, one_of
+from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
+from explaindrive.sim.scenario.choice import ScenarioFields
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
 
-class EnvConfig(ConfigModel):
+class EnvConfig(ConfigModel, ScenarioFields):
     """Settings of :class:`~explaindrive.env.urban_drive.UrbanDriveEnv`.
 
     Attributes:
@@ -21,15 +22,8 @@ class EnvConfig(ConfigModel):
         max_steps: step limit of an episode (truncation) [steps of 1 s].
         warmup_s: simulated time before the ego enters [s]; the state is cached.
         normalize_obs: return observations scaled into [-1, 1] (see ``env.state``).
-        net_file: a SUMO network to use instead of the shipped scenario: with ``route``
-            any network, else a build of the paper's road.
-        route: ``(FROM_EDGE, TO_EDGE)``: the ego drives SUMO's route between them on
-            ``net_file`` (see docs/scenario.md).
-        demand_file: background traffic on ``net_file`` (a SUMO route file, scaled by the
-            traffic level); without one, trips generated over the network.
-        scenario: a scenario directory (``explaindrive scenario build|random``), or
-            ``"random"``: a new generated scenario every ``scenario_every`` episodes.
-        scenario_every: episodes per drawn scenario under ``scenario="random"``.
+        scenario, scenario_every, net_file, route, demand_file: where the ego drives
+            (:class:`~explaindrive.sim.scenario.choice.ScenarioFields`).
         cache_dir: where generated demand files and warm-up states are kept.
         insert_timeout_s: how long the ego may wait for space to enter [s].
         ego_model: ``"agent"`` (the action sets the speed, SUMO's checks off) or a SUMO
@@ -47,25 +41,10 @@ class EnvConfig(ConfigModel):
     max_steps: PositiveInt = 1000
     warmup_s: NonNegativeInt = 180
     normalize_obs: bool = False
-    net_file: TextPath | None = None
-    route: Annotated[tuple[str, str], FROM_LIST] | None = None
-    demand_file: TextPath | None = None
-    scenario: str | None = None
-    scenario_every: PositiveInt = 20
     cache_dir: TextPath | None = None
     insert_timeout_s: PositiveInt = 60
     ego_model: Annotated[str, one_of(EGO_MODELS)] = "agent"
     yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = DEFAULT_YELLOW_LEADER
-
-    @model_validator(mode="after")
-    def _check_scenario(self) -> EnvConfig:
-        if self.scenario is not None and (self.net_file or self.route or self.demand_file):
-            raise ValueError("give a scenario or a network (net_file/route/demand_file), not both")
-        if self.route is not None and self.net_file is None:
-            raise ValueError("route needs net_file, the network it runs on")
-        if self.demand_file is not None and self.route is None:
-            raise ValueError("demand_file needs route and net_file")
-        return self
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any]) -> EnvConfig:

@@ -88,8 +88,9 @@ def run_episode(spec: EpisodeSpec) -> EpisodeRecord:
             Command.FAST if policy.kind == "merged" else Command.parse(policy.primary)
         )
     config = EnvConfig(
-        traffic_level=spec.traffic_level, max_steps=spec.max_steps, ego_model=policy.ego_model
-    )
+        traffic_level=spec.traffic_level, max_steps=spec.max_steps, ego_model=policy.ego_model,
+        **dict(spec.scenario),
+    )  # fmt: skip
     if driver is not None:  # a network drives in the environment it was trained in
         config = config.replace(yellow_leader=driver.yellow_leader)
     env = UrbanDriveEnv(config=config)

@@ -20,6 +20,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from explaindrive.commands import COMMAND_LABELS, Command
 from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
@@ -80,6 +81,8 @@ class EpisodeSpec:
         command: command from the first step (label).
         schedule: ``(time_s, command label)`` switches after the start.
         max_steps: step limit [steps of 1 s].
+        scenario: env config fields choosing the scenario (none: the paper's road).
+        scenario_name: how tables name that scenario.
     """
 
     policy: PolicySpec
@@ -88,6 +91,8 @@ class EpisodeSpec:
     command: str
     schedule: tuple[tuple[float, str], ...]
     max_steps: int = DEFAULT_MAX_STEPS
+    scenario: tuple[tuple[str, Any], ...] = ()
+    scenario_name: str = "paper"
 
 
 # ---------------------------------------------------------------------------- text parsers

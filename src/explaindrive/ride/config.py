@@ -8,9 +8,10 @@ from pydantic import AfterValidator, NonNegativeFloat, PositiveInt
 
 from explaindrive.config import ConfigModel, Seed, TextPath, TrafficLevel
 from explaindrive.language.backends import check_backend
+from explaindrive.sim.scenario.choice import ScenarioFields
 
 
-class RideConfig(ConfigModel):
+class RideConfig(ConfigModel, ScenarioFields):
     """Settings of :class:`~explaindrive.ride.session.RideSession`.
 
     Attributes:

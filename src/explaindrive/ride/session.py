@@ -147,6 +147,7 @@ class RideSession:
             traffic_level=config.traffic_level,
             max_steps=config.max_steps,
             yellow_leader=controller.yellow_leader,  # the networks' own rule
+            **config.scenario_fields(),
             render_mode="human" if config.gui else None,
         )
         self.lane = LanguageLane()
