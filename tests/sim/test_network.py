@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from pathlib import Path
 
@@ -26,7 +27,7 @@ def test_a_grid_route_passes_three_lights(netgen: Callable[..., Path]) -> None:
     geometry = load_route_geometry(net, edges)
     assert [light.tls_id for light in geometry.lights] == ["B1", "C1", "D1"]
     # the stop lines lie 200 m apart, one block each
-    gaps = [b.stop_line_m - a.stop_line_m for a, b in zip(geometry.lights, geometry.lights[1:])]
+    gaps = [b.stop_line_m - a.stop_line_m for a, b in itertools.pairwise(geometry.lights)]
     assert gaps == pytest.approx([200.0, 200.0], abs=0.5)
     assert geometry.crossings == () and geometry.limit_at(0.0) == pytest.approx(13.89)
 
@@ -77,7 +78,7 @@ def test_unusable_networks_and_routes_are_named(
         route_edges(paper, "PXS_PX", "J2_E0")
     nodes = tmp_path / "plain.nod.xml"
     nodes.write_text("<nodes/>")
-    with pytest.raises(NetworkError, match="is not a SUMO network .its root element is <nodes>"):
+    with pytest.raises(NetworkError, match=r"is not a SUMO network \(its root element is <nodes>"):
         route_edges(nodes, "a", "b")
     with pytest.raises(NetworkError, match="network file not found"):
         route_edges(tmp_path / "missing.net.xml", "a", "b")

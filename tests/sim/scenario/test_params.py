@@ -5,14 +5,14 @@ from __future__ import annotations
 import pytest
 
 from explaindrive.config import ConfigError
-from explaindrive.sim.scenario import layout
+from explaindrive.sim.scenario.layout import EGO_ROUTE_NODES, make_layout
 from explaindrive.sim.scenario.params import ScenarioParams
 
 
 def test_the_defaults_are_the_papers_road() -> None:
-    plan = layout.make_layout(ScenarioParams())
+    plan = make_layout(ScenarioParams())
     xs = {n.id: n.x for n in plan.nodes}
-    assert [xs[n] for n in layout.EGO_ROUTE_NODES] == [0, 400, 600, 800, 1000, 1200, 1550]
+    assert [xs[n] for n in EGO_ROUTE_NODES] == [0, 400, 600, 800, 1000, 1200, 1550]
     # J1: 37 + 2 * (3 + 2) + 13 = 60; J2 adds its 3 s pedestrian clearance: 34 + 10 + 3 + 13
     assert plan.tls_phase_durations_s == {"J1": (37, 3, 2, 13, 3, 2), "J2": (34, 3, 2, 13, 3, 3, 2)}
     assert plan.tls_offsets_s == {"J1": 0, "J2": 25}
@@ -24,7 +24,7 @@ def test_dotted_settings_change_one_value_each() -> None:
     p = ScenarioParams.from_settings(["limit_kmh=40", "j1.cycle_s=90", "demand.main_east=1000"])
     assert (p.limit_kmh, p.j1.cycle_s, p.j1.main_green_s, p.demand.main_east) == (40, 90, 37, 1000)
     # side green of J1 at a 90 s cycle: 90 - 37 - 2 * (3 + 2) = 43
-    assert layout.make_layout(p).tls_phase_durations_s["J1"] == (37, 3, 2, 43, 3, 2)
+    assert make_layout(p).tls_phase_durations_s["J1"] == (37, 3, 2, 43, 3, 2)
 
 
 @pytest.mark.parametrize(
