@@ -66,7 +66,7 @@ def test_a_scenario_directory_round_trips(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("end", ["low", "high"])
 def test_scenarios_at_the_ends_of_the_ranges_drive(end: str, tmp_path: Path) -> None:
-    directory = cached_scenario_dir(extreme_params(end), end, tmp_path)
+    directory = cached_scenario_dir(extreme_params(end), end, tmp_path)  # type: ignore[arg-type]
     env = UrbanDriveEnv(scenario=str(directory), max_steps=40, warmup_s=60, traffic_level=1.75)
     try:
         obs, info = env.reset(seed=1)
