@@ -37,5 +37,6 @@ def test_the_episode_starts_where_the_demand_does(
                     "--period", "4", "--seed", "1"], check=True, capture_output=True,
                    cwd=tmp_path)  # fmt: skip
     env = make_env(net_file=net, route=("A1B1", "D1E1"), demand_file=demand, warmup_s=60)
-    env.reset(seed=0)
-    assert env.sumo.simulation.getTime() == 25200 + 60 + 1
+    for level in (1.0, 1.5):  # 1.5: SUMO copies vehicles (--scale), the warm-up runs in place
+        env.reset(seed=0, options={"traffic_level": level})
+        assert env.sumo.simulation.getTime() == 25200 + 60 + 1

@@ -43,8 +43,10 @@ def test_a_random_network_with_guessed_lights(netgen: Callable[..., Path], tmp_p
     net = netgen("rand", "--rand.iterations", "40", "--tls.guess", "true")
     scenario = own_network(net, _two_far_edges(net), tmp_path)
     assert scenario.route_edges[0] != scenario.route_edges[-1]
-    assert scenario.begin_s == 0.0 and len(scenario.demand_files) == 1  # generated trips
-    assert scenario.demand_args(1.5) == ["--scale", "1.5"]
+    assert scenario.begin_s == 0.0 and scenario.trips  # trips generated per traffic level
+    # 60 veh/h per km of lane at level 1.0: 90 at level 1.5, no scaling by SUMO
+    assert scenario.routes_files(1.5)[1].name.endswith("_90.rou.xml")
+    assert scenario.demand_args(1.5) == []
 
 
 def _two_far_edges(net: Path) -> tuple[str, str]:

@@ -443,13 +443,21 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         return self.scenario.state_dir() / f"{demand}_seed{seed}_warm{self.config.warmup_s}.xml"
 
     def _restore_warm_state(self, level: float, seed: int) -> None:
-        """Continue from the cached warm-up state of (level, seed), creating it if needed."""
+        """Continue from the cached warm-up state of (level, seed), creating it if needed;
+        simulate the warm-up here where SUMO cannot reload its state (a scaled-up demand)."""
         if self.config.warmup_s == 0:
+            return
+        if not self.scenario.state_reloads(level):
+            for _ in range(self.config.warmup_s):
+                self._conn.api.simulationStep()
             return
         path = self._state_file(level, seed)
         if not path.exists():
             self._write_warm_state(level, seed, path)
-        self._conn.api.simulation.loadState(str(path))
+        try:
+            self._conn.api.simulation.loadState(str(path))
+        except Exception as exc:  # libsumo's own exception does not pickle to a parent process
+            raise RuntimeError(f"SUMO could not load the warm-up state {path}: {exc}") from None
 
     def _write_warm_state(self, level: float, seed: int, path: Path) -> None:
         """Simulate the warm-up in a fresh ``sumo`` process and save its state.

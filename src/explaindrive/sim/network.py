@@ -3,10 +3,10 @@
 The ego's route is SUMO's shortest path for passenger cars between two edges (sumolib);
 its stop lines, crossings and speed limits are then read along that route
 (:mod:`explaindrive.sim.route`). The background demand is a route file of your own,
-starting wherever its first departure is (e.g. 25200 s, 7:00), or else trips that SUMO's
-``randomTrips.py`` generates over the whole network. Either way the traffic level scales it
-(SUMO's ``--scale``; 1.0 is the file as given, or :data:`TRIPS_PER_HOUR_PER_KM` for
-generated trips).
+starting wherever its first departure is (e.g. 25200 s, 7:00), which the traffic level
+scales (SUMO's ``--scale``; 1.0 is the file as given), or else trips that SUMO's
+``randomTrips.py`` generates over the whole network, :data:`TRIPS_PER_HOUR_PER_KM` times
+the traffic level.
 """
 
 from __future__ import annotations
@@ -110,15 +110,16 @@ def demand_begin_s(demand_file: Path) -> float:
     return 0.0 if first == float("inf") else first
 
 
-def generated_trips(net_file: Path, cache_dir: Path) -> Path:
-    """Background trips over the whole network at traffic level 1.0, made once per network
-    with ``randomTrips.py`` and cached.
+def generated_trips(net_file: Path, cache_dir: Path, traffic_level: float = 1.0) -> Path:
+    """Background trips over the whole network at a traffic level, made once per network and
+    level with ``randomTrips.py`` and cached.
 
     Raises:
         NetworkError: if randomTrips fails (e.g. no two edges are connected).
     """
     digest = hashlib.sha1(net_file.read_bytes()).hexdigest()[:10]
-    path = cache_dir / "trips" / f"{digest}_{TRIPS_PER_HOUR_PER_KM:g}.rou.xml"
+    density = TRIPS_PER_HOUR_PER_KM * traffic_level  # [veh/h per km of lane]
+    path = cache_dir / "trips" / f"{digest}_{density:g}.rou.xml"
     if path.exists():
         return path
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -127,7 +128,7 @@ def generated_trips(net_file: Path, cache_dir: Path) -> Path:
     args = [
         sys.executable, str(script), "-n", str(net_file), "-o", str(tmp / "trips.xml"),
         "-r", str(tmp / "routes.rou.xml"), "--begin", "0", "--end", str(FLOW_END_S),
-        "--insertion-density", f"{TRIPS_PER_HOUR_PER_KM:g}", "--seed", str(TRIPS_SEED),
+        "--insertion-density", f"{density:g}", "--seed", str(TRIPS_SEED),
         "--vehicle-class", "passenger", "--fringe-factor", "5", "--min-distance", "100",
         "--prefix", "bg", "--validate",
         "--trip-attributes", 'departLane="best" departSpeed="max"',
@@ -164,15 +165,17 @@ def own_network(
     except (ValueError, KeyError) as exc:
         raise NetworkError(f"route {route[0]} -> {route[1]} cannot be driven: {exc}") from None
     if demand_file is not None:
-        demand, begin = demand_file, demand_begin_s(demand_file)
+        demand, begin = (demand_file,), demand_begin_s(demand_file)
     else:
-        demand, begin = generated_trips(net_file, cache_dir), 0.0
+        generated_trips(net_file, cache_dir)  # made now: a network without trips fails here
+        demand, begin = (), 0.0
     return ScenarioFiles(
         net_file=net_file,
         cache_dir=cache_dir,
         route_edges=edges,
         plan=None,
-        demand_files=(demand,),
+        demand_files=demand,
+        trips=demand_file is None,
         begin_s=begin,
         name=f"{net_file.name}:{route[0]}->{route[1]}",
     )

@@ -99,6 +99,8 @@ class ScenarioFiles:
             own network, whose demand is ``demand_files``.
         demand_files: background demand of an own network; SUMO scales it by the traffic
             level (``--scale``).
+        trips: whether an own network's demand is trips generated over it at the traffic
+            level (:func:`explaindrive.sim.network.generated_trips`).
         begin_s: simulation time at which the demand starts [s]; the warm-up runs from it.
         name: how tables and logs name the scenario.
     """
@@ -108,6 +110,7 @@ class ScenarioFiles:
     route_edges: tuple[str, ...] = layout.EGO_ROUTE_EDGES
     plan: layout.Layout | None = layout.PAPER_LAYOUT
     demand_files: tuple[Path, ...] = ()
+    trips: bool = False
     begin_s: float = 0.0
     name: str = "paper"
 
@@ -124,6 +127,11 @@ class ScenarioFiles:
 
     def routes_files(self, traffic_level: float) -> tuple[Path, ...]:
         """The route files SUMO loads at a traffic level: the generated one first."""
+        if self.trips:
+            from explaindrive.sim.network import generated_trips
+
+            return (self.routes_file(traffic_level),
+                    generated_trips(self.net_file, self.cache_dir, traffic_level))  # fmt: skip
         return (self.routes_file(traffic_level), *self.demand_files)
 
     def demand_args(self, traffic_level: float) -> list[str]:
@@ -133,12 +141,18 @@ class ScenarioFiles:
             args += ["--scale", f"{traffic_level:g}"]
         return args
 
+    def state_reloads(self, traffic_level: float) -> bool:
+        """Whether a saved warm-up state reloads: not for a demand file scaled above 1, whose
+        copied vehicles SUMO 1.28 cannot restore (their routes are unknown on loading)."""
+        return not (self.demand_files and traffic_level > 1.0)
+
     def demand_key(self, traffic_level: float) -> str:
         """Names the demand at a traffic level (level and content hash) in cached files."""
         key = self.routes_file(traffic_level).name.removesuffix(".rou.xml")
-        if not self.demand_files and not self.begin_s:
+        if not self.demand_files and not self.trips and not self.begin_s:
             return key
-        extra = "|".join([*(_digest(p) for p in self.demand_files), f"{self.begin_s:g}"])
+        files = self.routes_files(traffic_level)[1:]
+        extra = "|".join([*(_digest(p) for p in files), f"{self.begin_s:g}"])
         return f"{key}_{hashlib.sha1(extra.encode()).hexdigest()[:10]}"
 
     def check(self) -> None:
