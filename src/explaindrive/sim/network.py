@@ -164,6 +164,7 @@ def own_network(
         load_route_geometry(net_file, edges)
     except (ValueError, KeyError) as exc:
         raise NetworkError(f"route {route[0]} -> {route[1]} cannot be driven: {exc}") from None
+    demand: tuple[Path, ...]
     if demand_file is not None:
         demand, begin = (demand_file,), demand_begin_s(demand_file)
     else:
