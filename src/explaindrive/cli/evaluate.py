@@ -10,7 +10,7 @@ from rich.console import Console
 
 from explaindrive.cli import _grid_options as grid
 from explaindrive.cli import _scenario_options as where
-from explaindrive.cli._errors import error_line
+from explaindrive.cli._errors import error_line, print_error
 from explaindrive.cli._grid_options import err_console
 from explaindrive.evaluation.paper import PAPER_SEEDS
 
@@ -91,7 +91,7 @@ def evaluate_command(
         )  # fmt: skip
         plan = _in_scenarios(plan, scenario, scenarios, net, route, demand)
     except (SpecError, where.ScenarioChoiceError) as exc:
-        err_console.print(error_line(exc))
+        print_error(err_console, exc)
         raise typer.Exit(2) from None
     if (problem := grid.check_ray_target(ray, ray_address)) is not None:
         err_console.print(error_line(problem))
