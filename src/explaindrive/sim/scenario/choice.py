@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Self
 
-from pydantic import PositiveInt, model_validator
+from pydantic import PositiveInt, SerializerFunctionWrapHandler, model_serializer, model_validator
 
 from explaindrive.config import FROM_LIST, StrictModel, TextPath
 
@@ -41,7 +41,19 @@ class ScenarioFields(StrictModel):
             raise ValueError("demand_file needs route and net_file")
         return self
 
+    @model_serializer(mode="wrap")
+    def _drop_defaults(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """Leave the scenario settings at their defaults out of dumps and saved configs, so
+        a config of the paper's road reads as it did before scenarios could be chosen."""
+        data: dict[str, Any] = handler(self)
+        for key in _SCENARIO_KEYS:
+            if key in data and data[key] == ScenarioFields.model_fields[key].default:
+                del data[key]
+        return data
+
     def scenario_fields(self) -> dict[str, Any]:
         """The scenario settings that are set, as env config fields."""
-        names = ("scenario", "scenario_every", "net_file", "route", "demand_file")
-        return {k: getattr(self, k) for k in names if getattr(self, k) is not None}
+        return {k: getattr(self, k) for k in _SCENARIO_KEYS if getattr(self, k) is not None}
+
+
+_SCENARIO_KEYS = ("scenario", "scenario_every", "net_file", "route", "demand_file")
