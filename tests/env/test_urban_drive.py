@@ -290,3 +290,12 @@ def test_pedestrians_do_not_step_in_front_of_the_ego_at_the_zebra(make_env):
             if terminated or truncated or front > zebra.end_m + 50.0:
                 break
     assert held_steps > 0  # the rule was exercised
+
+
+def test_the_ego_enters_the_busiest_road(make_env) -> None:
+    # level 2.0: 1800 veh/h towards J1, whose main green passes about 1100; background cars
+    # that cannot enter within 20 s are dropped, so the ego enters (seed 7 stayed blocked
+    # for 60 s without that rule)
+    env = make_env(traffic_level=2.0, max_steps=5)
+    env.reset(seed=7)
+    assert env.sumo.simulation.getTime() <= 180 + 21

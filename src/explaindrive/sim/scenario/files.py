@@ -139,6 +139,8 @@ class ScenarioFiles:
         args = ["--begin", f"{self.begin_s:g}"] if self.begin_s else []
         if self.demand_files:
             args += ["--scale", f"{traffic_level:g}"]
+        if traffic_level > layout.SATURATED_LEVEL:
+            args += ["--max-depart-delay", str(layout.MAX_DEPART_DELAY_S)]
         return args
 
     def state_reloads(self, traffic_level: float) -> bool:
@@ -149,10 +151,11 @@ class ScenarioFiles:
     def demand_key(self, traffic_level: float) -> str:
         """Names the demand at a traffic level (level and content hash) in cached files."""
         key = self.routes_file(traffic_level).name.removesuffix(".rou.xml")
-        if not self.demand_files and not self.trips and not self.begin_s:
+        args = self.demand_args(traffic_level)
+        if not self.demand_files and not self.trips and not args:
             return key
         files = self.routes_files(traffic_level)[1:]
-        extra = "|".join([*(_digest(p) for p in files), f"{self.begin_s:g}"])
+        extra = "|".join([*(_digest(p) for p in files), *args])
         return f"{key}_{hashlib.sha1(extra.encode()).hexdigest()[:10]}"
 
     def check(self) -> None:

@@ -23,7 +23,9 @@ from dataclasses import dataclass
 from itertools import pairwise
 
 from explaindrive.sim.scenario.limits import (
+    MAX_DEPART_DELAY_S,
     MAX_TRAFFIC_LEVEL,
+    SATURATED_LEVEL,
     SEED_LIMIT,
     TRAFFIC_LEVELS,
     validate_seed,
@@ -199,11 +201,13 @@ __all__ = [
     "EGO_ROUTE_NODES",
     "FLOWS",
     "KMH",
+    "MAX_DEPART_DELAY_S",
     "MAX_TRAFFIC_LEVEL",
     "NODES",
     "PAPER_LAYOUT",
     "PEDESTRIAN_FLOWS",
     "ROADS",
+    "SATURATED_LEVEL",
     "SEED_LIMIT",
     "TRAFFIC_LEVELS",
     "Layout",
