@@ -8,6 +8,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from explaindrive.env import state as S
+from explaindrive.env.scripted import CautiousDriver
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.sim.sumo_home import sumo_home
 from tests.conftest import GRID_WITH_LIGHTS
@@ -40,3 +41,20 @@ def test_the_episode_starts_where_the_demand_does(
     for level in (1.0, 1.5):  # 1.5: SUMO copies vehicles (--scale), the warm-up runs in place
         env.reset(seed=0, options={"traffic_level": level})
         assert env.sumo.simulation.getTime() == 25200 + 60 + 1
+
+
+def test_sumo_changes_lanes_to_follow_the_route(
+    make_env: Callable[..., UrbanDriveEnv], netgen: Callable[..., Path]
+) -> None:
+    net = netgen("grid", *GRID_WITH_LIGHTS, "--default.lanenumber", "2")
+    env = make_env(net_file=net, route=("A0B0", "D3D4"), max_steps=300, warmup_s=0)
+    obs, _ = env.reset(seed=0)
+    driver, lanes = CautiousDriver(), set()
+    for _ in range(300):
+        obs, _r, terminated, truncated, info = env.step(driver(obs))
+        if terminated or truncated:
+            break
+        lanes.add(env.sumo.vehicle.getLaneID("ego"))
+    # straight on in the left lane of B2B3, then over to its right lane for the right turn
+    assert {"B2B3_0", "B2B3_1"} <= lanes
+    assert info["arrived"] and not info["collision"]

@@ -96,3 +96,15 @@ def test_the_demand_starts_at_its_first_departure(tmp_path: Path) -> None:
         '<vehicle id="b" depart="triggered"><route edges="x"/></vehicle></routes>'
     )
     assert demand_begin_s(demand) == 25200.0
+
+
+def test_each_lane_that_leads_on_has_its_own_signal_link(netgen: Callable[..., Path]) -> None:
+    net = netgen("grid", *GRID_WITH_LIGHTS, "--default.lanenumber", "2")
+    edges = route_edges(net, "A0B0", "D3D4")
+    assert edges == ("A0B0", "B0B1", "B1B2", "B2B3", "B3C3", "C3D3", "D3D4")
+    lights = {light.tls_id: light for light in load_route_geometry(net, edges).lights}
+    # straight on at B1 from both lanes; the right turn at B3 only from the right lane
+    assert [lane for lane, _ in lights["B1"].lane_links] == ["B0B1_0", "B0B1_1"]
+    assert [lane for lane, _ in lights["B3"].lane_links] == ["B2B3_0"]
+    assert lights["B3"].link_of("B2B3_1") is None
+    assert lights["B1"].link_of("B0B1_0") != lights["B1"].link_of("B0B1_1")

@@ -44,7 +44,7 @@ from explaindrive.env.reward import (
 )
 from explaindrive.sim.connection import SumoConnection
 from explaindrive.sim.pedestrians import KerbYield, PedestrianSource
-from explaindrive.sim.route import RouteCrossing, RouteGeometry, load_route_geometry
+from explaindrive.sim.route import RouteCrossing, RouteGeometry, RouteLight, load_route_geometry
 from explaindrive.sim.scenario.files import (
     BASELINE_EGO_TYPES,
     EGO_ID,
@@ -59,6 +59,7 @@ from explaindrive.sim.sumo_home import sumo_binary
 log = logging.getLogger(__name__)
 
 _EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER)
+_EGO_LANE_VARS = (*_EGO_VARS, tc.VAR_LANE_ID)  # where SUMO changes the ego's lanes
 _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
@@ -126,6 +127,7 @@ class _Episode:
     pedestrians: PedestrianSource | None = None
     kerb: KerbYield = field(default_factory=KerbYield)
     amber: AmberDecision = field(default_factory=AmberDecision)
+    lane_id: str | None = None  # the ego's lane, read where SUMO changes its lanes
 
 
 class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
@@ -517,7 +519,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         if model == "agent":
             api.vehicle.setSpeedMode(EGO_ID, 0)  # no car-following, light or right-of-way checks
             api.vehicle.setSpeed(EGO_ID, 0.0)
-        api.vehicle.subscribe(EGO_ID, _EGO_VARS, parameters={tc.VAR_LEADER: S.SENSOR_RANGE_M})
+        ego_vars = _EGO_LANE_VARS if self.scenario.strategic_lane_changes else _EGO_VARS
+        api.vehicle.subscribe(EGO_ID, ego_vars, parameters={tc.VAR_LEADER: S.SENSOR_RANGE_M})
         if not self._tls_link:
             self._tls_link = {t[0]: int(t[1]) for t in api.vehicle.getNextTLS(EGO_ID)}
         for tls_id in self._tls_link:
@@ -586,6 +589,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         """
         ep = self._episode()
         v = float(ego[tc.VAR_SPEED])
+        ep.lane_id = ego.get(tc.VAR_LANE_ID)
         rng = S.SENSOR_RANGE_M
         real = self._real_leader(api, ego)
         leader = real
@@ -636,14 +640,19 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             if ahead < 0.0 or light.tls_id not in self._tls_link:
                 continue
             states = api.trafficlight.getSubscriptionResults(light.tls_id)
-            colour = S.LightState.from_sumo(
-                states[tc.TL_RED_YELLOW_GREEN_STATE][self._tls_link[light.tls_id]]
-            )
+            colour = S.LightState.from_sumo(states[tc.TL_RED_YELLOW_GREEN_STATE][self._link(light)])
             ep.light_state[light.tls_id] = colour
             if ahead < S.SENSOR_RANGE_M:
                 d_tl, tls, light_id = ahead, colour, light.tls_id
             break
         return d_tl, tls, light_id
+
+    def _link(self, light: RouteLight) -> int:
+        """The ego's link at ``light``: the one from the lane it is on when that lane
+        approaches the light, else the one it was routed through at entry."""
+        lane = self._episode().lane_id
+        index = light.link_of(lane) if lane is not None else None
+        return self._tls_link[light.tls_id] if index is None else index
 
     def _next_busy_crossing(self, pos: float) -> float:
         """Distance to the nearest crossing a pedestrian is on or entering (range if none);
@@ -671,7 +680,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         for light in self.geometry.lights:
             if prev_pos < light.stop_line_m <= pos and light.tls_id in self._tls_link:
                 states = self._conn.api.trafficlight.getSubscriptionResults(light.tls_id)
-                char = states[tc.TL_RED_YELLOW_GREEN_STATE][self._tls_link[light.tls_id]]
+                char = states[tc.TL_RED_YELLOW_GREEN_STATE][self._link(light)]
                 return S.LightState.from_sumo(char) is S.LightState.RED
         return False
 

@@ -22,6 +22,17 @@ class RouteLight:
 
     tls_id: str
     stop_line_m: float  # [m] route position of the stop line
+    lane_links: tuple[tuple[str, int], ...] = ()
+    """(approach lane, index of its link in the light's state) for every lane that leads on
+    along the route (several on a multi-lane road)."""
+
+    def link_of(self, lane_id: str) -> int | None:
+        """The index of the link the ego follows from ``lane_id`` (``None``: not an
+        approach lane of this light)."""
+        for lane, index in self.lane_links:
+            if lane == lane_id:
+                return index
+        return None
 
 
 @dataclass(frozen=True, slots=True)
@@ -83,7 +94,11 @@ def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGe
     edge_to = {e.attrib["id"]: e.get("to") for e in root.iter("edge") if not e.get("function")}
     nodes = {j.attrib["id"]: j for j in root.iter("junction")}
     lights = [
-        RouteLight(tls_id=tls_id, stop_line_m=layout.end[eid])
+        RouteLight(
+            tls_id=tls_id,
+            stop_line_m=layout.end[eid],
+            lane_links=tuple(net.links.get((eid, nxt), ())),
+        )
         for eid, nxt in itertools.pairwise(route_edges)
         if (tls_id := net.conns[(eid, nxt)].get("tl"))
     ]
@@ -107,6 +122,7 @@ class _Network:
     edge_lane: dict[str, str]  # normal edge -> its vehicle lane
     conns: dict[tuple[str, str], ET.Element]  # (edge, next edge) -> connection with a via lane
     via_next: dict[str, str]  # internal lane -> the next internal lane
+    links: dict[tuple[str, str], list[tuple[str, int]]]  # (edge, next) -> signalled links
 
     @classmethod
     def read(cls, root: ET.Element) -> _Network:
@@ -120,6 +136,7 @@ class _Network:
                     car_lanes.add(lane.attrib["id"])
                     edge_lane[edge.attrib["id"]] = lane.attrib["id"]  # the leftmost car lane
         conns: dict[tuple[str, str], ET.Element] = {}
+        links: dict[tuple[str, str], list[tuple[str, int]]] = {}
         via_next: dict[str, str] = {}
         for c in root.iter("connection"):
             src, dst = c.attrib["from"], c.attrib["to"]
@@ -132,7 +149,9 @@ class _Network:
             usable = dst in edge_lane and lane_from in car_lanes
             if usable and (lane_from == edge_lane.get(src) or (src, dst) not in conns):
                 conns[(src, dst)] = c
-        return cls(_lane_lengths(root), edge_lane, conns, via_next)
+            if usable and c.get("tl") and c.get("linkIndex") is not None:
+                links.setdefault((src, dst), []).append((lane_from, int(c.attrib["linkIndex"])))
+        return cls(_lane_lengths(root), edge_lane, conns, via_next, links)
 
 
 def _allows_cars(lane: ET.Element) -> bool:
