@@ -485,7 +485,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         proc = subprocess.run(args, capture_output=True, text=True, check=False)
         if proc.returncode != 0:
             Path(tmp).unlink(missing_ok=True)
-            raise RuntimeError(f"SUMO warm-up failed ({proc.returncode}): {proc.stderr[-2000:]}")
+            detail = " ".join(proc.stderr.split())[-2000:]  # one line: SUMO's own span several
+            raise RuntimeError(f"SUMO warm-up failed ({proc.returncode}): {detail}")
         os.replace(tmp, path)
 
     def _insert_ego(self) -> float:
