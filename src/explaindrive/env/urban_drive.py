@@ -9,12 +9,8 @@ from __future__ import annotations
 
 import logging
 import math
-import os
-import subprocess
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -42,6 +38,7 @@ from explaindrive.env.reward import (
     time_headway,
     time_to_collision,
 )
+from explaindrive.env.warm_start import restore_warm_state, sumo_args
 from explaindrive.sim.connection import SumoConnection
 from explaindrive.sim.pedestrians import KerbYield, PedestrianSource
 from explaindrive.sim.route import RouteCrossing, RouteGeometry, RouteLight, load_route_geometry
@@ -54,7 +51,6 @@ from explaindrive.sim.scenario.files import (
 )
 from explaindrive.sim.scenario.limits import SEED_LIMIT, validate_seed
 from explaindrive.sim.scenario.source import ScenarioSource
-from explaindrive.sim.sumo_home import sumo_binary
 
 log = logging.getLogger(__name__)
 
@@ -229,8 +225,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         validate_seed(sumo_seed)
         self._use_scenario(self._scenarios.for_episode(int(sumo_seed)))
         try:
-            self._conn.start_or_load(self._sumo_args(level, int(sumo_seed)))
-            self._restore_warm_state(level, int(sumo_seed))
+            self._conn.start_or_load(sumo_args(self.scenario, level, int(sumo_seed)))
+            restore_warm_state(self._conn.api, self.scenario, level, int(sumo_seed),
+                               self.config.warmup_s)  # fmt: skip
             start_pos = self._insert_ego()
         except BaseException:
             self.close()
@@ -412,82 +409,6 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges)
         self._tls_link = {}
         self._conn.close()  # the next episode starts SUMO on the new network
-
-    def _sumo_args(self, level: float, seed: int) -> list[str]:
-        return [
-            "-n",
-            str(self.scenario.net_file),
-            "-r",
-            ",".join(str(p) for p in self.scenario.routes_files(level)),
-            *self.scenario.demand_args(level),
-            "--seed",
-            str(seed),
-            "--step-length",
-            str(STEP_LENGTH_S),
-            "--no-step-log",
-            "true",
-            "--no-warnings",
-            "true",
-            "--collision.action",
-            "remove",
-            "--collision.check-junctions",
-            "true",
-            "--collision.mingap-factor",
-            "0",
-            "--save-state.rng",
-            "true",
-            "--time-to-teleport",
-            "-1",
-        ]
-
-    def _state_file(self, level: float, seed: int) -> Path:
-        demand = self.scenario.demand_key(level)  # level + hash
-        return self.scenario.state_dir() / f"{demand}_seed{seed}_warm{self.config.warmup_s}.xml"
-
-    def _restore_warm_state(self, level: float, seed: int) -> None:
-        """Continue from the cached warm-up state of (level, seed), creating it if needed;
-        simulate the warm-up here where SUMO cannot reload its state (a scaled-up demand)."""
-        if self.config.warmup_s == 0:
-            return
-        if not self.scenario.state_reloads(level):
-            for _ in range(self.config.warmup_s):
-                self._conn.api.simulationStep()
-            return
-        path = self._state_file(level, seed)
-        if not path.exists():
-            self._write_warm_state(level, seed, path)
-        try:
-            self._conn.api.simulation.loadState(str(path))
-        except Exception as exc:  # libsumo's own exception does not pickle to a parent process
-            raise RuntimeError(f"SUMO could not load the warm-up state {path}: {exc}") from None
-
-    def _write_warm_state(self, level: float, seed: int, path: Path) -> None:
-        """Simulate the warm-up in a fresh ``sumo`` process and save its state.
-
-        A separate process keeps the result independent of whatever this process
-        simulated before (libsumo keeps some random state across restarts).
-        """
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".xml")
-        os.close(fd)
-        begin = self.scenario.begin_s
-        warmup = f"{begin + self.config.warmup_s:g}"
-        args = [
-            sumo_binary("sumo"),
-            *self._sumo_args(level, seed),
-            "--end",
-            f"{begin + self.config.warmup_s + 1:g}",
-            "--save-state.times",
-            warmup,
-            "--save-state.files",
-            tmp,
-        ]
-        proc = subprocess.run(args, capture_output=True, text=True, check=False)
-        if proc.returncode != 0:
-            Path(tmp).unlink(missing_ok=True)
-            detail = " ".join(proc.stderr.split())[-2000:]  # one line: SUMO's own span several
-            raise RuntimeError(f"SUMO warm-up failed ({proc.returncode}): {detail}")
-        os.replace(tmp, path)
 
     def _insert_ego(self) -> float:
         api = self._conn.api
