@@ -293,9 +293,10 @@ def test_pedestrians_do_not_step_in_front_of_the_ego_at_the_zebra(make_env):
 
 
 def test_the_ego_enters_the_busiest_road(make_env) -> None:
-    # level 2.0: 1800 veh/h towards J1, whose main green passes about 1100; background cars
-    # that cannot enter within 20 s are dropped, so the ego enters (seed 7 stayed blocked
-    # for 60 s without that rule)
+    # level 2.0: 1800 veh/h towards J1, whose main green passes about 1100; when the entry
+    # is cleared after 10 s, the cars waiting to enter there are dropped too, so the ego
+    # enters in the step after that clear: 11 steps of waiting, then 1 (seed 7 stayed
+    # blocked for 60 s without that rule)
     env = make_env(traffic_level=2.0, max_steps=5)
     env.reset(seed=7)
-    assert env.sumo.simulation.getTime() <= 180 + 21
+    assert env.sumo.simulation.getTime() == 180 + 12

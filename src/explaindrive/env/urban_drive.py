@@ -49,7 +49,7 @@ from explaindrive.sim.scenario.files import (
     EGO_TYPE_ID,
     ScenarioFiles,
 )
-from explaindrive.sim.scenario.limits import SEED_LIMIT, validate_seed
+from explaindrive.sim.scenario.limits import SATURATED_LEVEL, SEED_LIMIT, validate_seed
 from explaindrive.sim.scenario.source import ScenarioSource
 
 log = logging.getLogger(__name__)
@@ -228,7 +228,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             self._conn.start_or_load(sumo_args(self.scenario, level, int(sumo_seed)))
             restore_warm_state(self._conn.api, self.scenario, level, int(sumo_seed),
                                self.config.warmup_s)  # fmt: skip
-            start_pos = self._insert_ego()
+            start_pos = self._insert_ego(drop_backlog=level > SATURATED_LEVEL)
         except BaseException:
             self.close()
             raise
@@ -410,7 +410,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._tls_link = {}
         self._conn.close()  # the next episode starts SUMO on the new network
 
-    def _insert_ego(self) -> float:
+    def _insert_ego(self, drop_backlog: bool = False) -> float:
         api = self._conn.api
         model = self.config.ego_model
         type_id = EGO_TYPE_ID if model == "agent" else BASELINE_EGO_TYPES[model]
@@ -428,7 +428,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             if EGO_ID in api.simulation.getDepartedIDList():
                 break
             if waited and waited % ENTRY_CLEAR_AFTER_S == 0:
-                self._clear_entry()
+                self._clear_entry(drop_backlog)
         else:
             raise RuntimeError(
                 f"the ego could not enter within {self.config.insert_timeout_s} s "
@@ -453,10 +453,16 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
                 api.edge.subscribe(edge, (tc.LAST_STEP_PERSON_ID_LIST,))
         return float(api.vehicle.getLanePosition(EGO_ID))
 
-    def _clear_entry(self) -> None:
-        """Remove background vehicles from the ego's entry stretch (oversaturated demand)."""
+    def _clear_entry(self, drop_backlog: bool) -> None:
+        """Remove background vehicles from the ego's entry stretch (oversaturated demand), and
+        with ``drop_backlog`` those still waiting to enter there, which SUMO would insert
+        before the ego."""
         api = self._conn.api
         edge = self.scenario.route_edges[0]
+        if drop_backlog:
+            for vid in api.simulation.getPendingVehicles():
+                if vid != EGO_ID and api.vehicle.getRoute(vid)[0] == edge:
+                    api.vehicle.remove(vid)
         lanes = [f"{edge}_{i}" for i in range(api.edge.getLaneNumber(edge))]
         for vid in (v for lane in lanes for v in api.lane.getLastStepVehicleIDs(lane)):
             if vid != EGO_ID and api.vehicle.getLanePosition(vid) < ENTRY_CLEAR_M:

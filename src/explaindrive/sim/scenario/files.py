@@ -139,8 +139,6 @@ class ScenarioFiles:
         args = ["--begin", f"{self.begin_s:g}"] if self.begin_s else []
         if self.demand_files:
             args += ["--scale", f"{traffic_level:g}"]
-        if traffic_level > layout.SATURATED_LEVEL:
-            args += ["--max-depart-delay", str(layout.MAX_DEPART_DELAY_S)]
         return args
 
     def state_reloads(self, traffic_level: float) -> bool:

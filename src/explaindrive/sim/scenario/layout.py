@@ -23,7 +23,6 @@ from dataclasses import dataclass
 from itertools import pairwise
 
 from explaindrive.sim.scenario.limits import (
-    MAX_DEPART_DELAY_S,
     MAX_TRAFFIC_LEVEL,
     SATURATED_LEVEL,
     SEED_LIMIT,
@@ -201,7 +200,6 @@ __all__ = [
     "EGO_ROUTE_NODES",
     "FLOWS",
     "KMH",
-    "MAX_DEPART_DELAY_S",
     "MAX_TRAFFIC_LEVEL",
     "NODES",
     "PAPER_LAYOUT",
