@@ -108,3 +108,17 @@ def test_each_lane_that_leads_on_has_its_own_signal_link(netgen: Callable[..., P
     assert [lane for lane, _ in lights["B3"].lane_links] == ["B2B3_0"]
     assert lights["B3"].link_of("B2B3_1") is None
     assert lights["B1"].link_of("B0B1_0") != lights["B1"].link_of("B0B1_1")
+
+
+def test_guessed_crossings_are_read_along_the_route(netgen: Callable[..., Path]) -> None:
+    options = ("--sidewalks.guess", "true", "--crossings.guess", "true")
+    net = netgen("grid", *GRID_WITH_LIGHTS, *options)
+    geometry = load_route_geometry(net, route_edges(net, "A1B1", "D1E1"))
+    # at each of B1, C1, D1 one crossing over the arm the ego comes from, one over the arm
+    # it leaves by; both signalised, both before the light's stop line
+    assert [c.crossing_edge.split("_")[0] for c in geometry.crossings] == [
+        ":B1", ":B1", ":C1", ":C1", ":D1", ":D1"
+    ]  # fmt: skip
+    assert all(c.signalized for c in geometry.crossings)
+    stops = sorted({c.stop_line_m for c in geometry.crossings})
+    assert stops == [light.stop_line_m for light in geometry.lights]
