@@ -57,3 +57,30 @@ def make_env() -> Iterator[Callable[..., UrbanDriveEnv]]:
     yield factory
     for env in made:
         env.close()
+
+
+@pytest.fixture(scope="session")
+def netgen(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., Path]:
+    """Networks that SUMO's own ``netgenerate`` makes: ``netgen("grid", *options)``."""
+    import subprocess
+
+    from explaindrive.sim.sumo_home import sumo_binary
+
+    made: dict[tuple[str, ...], Path] = {}
+
+    def build(kind: str, *options: str) -> Path:
+        key = (kind, *options)
+        if key not in made:
+            out = tmp_path_factory.mktemp("net") / f"{kind}.net.xml"
+            args = [sumo_binary("netgenerate"), f"--{kind}", *options, "-o", str(out),
+                    "--seed", "7", "--no-turnarounds", "true"]  # fmt: skip
+            subprocess.run(args, check=True, capture_output=True)
+            made[key] = out
+        return made[key]
+
+    return build
+
+
+GRID_WITH_LIGHTS = ("--grid.number", "5", "--grid.length", "200",
+                    "--default-junction-type", "traffic_light")  # fmt: skip
+"""A 5x5 grid of 200 m blocks whose junctions all have lights."""

@@ -76,7 +76,7 @@ def test_unknown_keys_are_named_with_the_known_ones() -> None:
         ({"name": 3}, "name: Input should be a valid string, got 3"),
         ({"sizes": {1, 2}}, "sizes: Input should be a valid tuple"),
         ({"sizes": [1, 2.5]}, "sizes.1: Input should be a valid integer, got 2.5"),
-        ({"level": 2.0}, "level: traffic level must be at most 1.75, got 2: on a busier road"),
+        ({"level": 2.5}, "level: traffic level must be at most 2, got 2.5: on a busier road"),
         ({"seed": 2**31}, "seed: seed must be an integer in [0, 2**31), got 2147483648"),
     ],
 )

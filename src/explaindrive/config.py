@@ -11,7 +11,7 @@ are given as lists in JSON and YAML (:data:`FROM_LIST`) and paths as text (:data
 :class:`ConfigError` whose one line names every bad key (:func:`config_error`),
 :meth:`~ConfigModel.from_dict`, a validated :meth:`~ConfigModel.replace` and JSON-ready
 :meth:`~ConfigModel.to_dict`. :data:`TrafficLevel` and :data:`Seed` check a value against
-the scenario's one definition of its range (:mod:`explaindrive.sim.scenario.layout`).
+the scenario's one definition of its range (:mod:`explaindrive.sim.scenario.limits`).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from pydantic import (
     ValidationError,
 )
 
-from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
+from explaindrive.sim.scenario.limits import validate_seed, validate_traffic_level
 from explaindrive.validation import describe_error
 
 
@@ -140,10 +140,10 @@ TextPath = Annotated[Path, Field(strict=False)]
 """A path, also given as text."""
 
 TrafficLevel = Annotated[float, BeforeValidator(validate_traffic_level)]
-"""A traffic level in (0, :data:`~explaindrive.sim.scenario.layout.MAX_TRAFFIC_LEVEL`]."""
+"""A traffic level in (0, :data:`~explaindrive.sim.scenario.limits.MAX_TRAFFIC_LEVEL`]."""
 
 Seed = Annotated[int, BeforeValidator(validate_seed)]
-"""A simulation seed in [0, :data:`~explaindrive.sim.scenario.layout.SEED_LIMIT`)."""
+"""A simulation seed in [0, :data:`~explaindrive.sim.scenario.limits.SEED_LIMIT`)."""
 
 
 def one_of(choices: tuple[str, ...]) -> AfterValidator:

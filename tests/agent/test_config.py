@@ -104,8 +104,8 @@ def test_unknown_keys_and_bad_values_are_reported_together() -> None:
         ({"hidden_sizes": [64, 32.0]}, "hidden_sizes.1: Input should be a valid integer"),
         ({"traffic_levels": []}, "traffic_levels: Value should have at least 1 item"),
         (
-            {"traffic_levels": [0.5, 2.0]},
-            "traffic_levels.1: traffic level must be at most 1.75, got 2",
+            {"traffic_levels": [0.5, 2.5]},
+            "traffic_levels.1: traffic level must be at most 2, got 2.5",
         ),
         ({"seed": -1}, "seed: seed must be an integer in [0, 2**31), got -1"),
         ({"lr": "fast"}, "lr: Input should be a valid number, got 'fast'"),

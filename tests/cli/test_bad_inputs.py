@@ -82,7 +82,7 @@ def test_ride_script_that_is_not_utf8(tmp_path: Path) -> None:
             "explanation_cooldown_s: Input should be greater than or equal to 0, got -1.0",
         ),
         (["--traffic", "nan"], "traffic_level: traffic level must be a finite number > 0, got nan"),
-        (["--traffic", "99"], "traffic_level: traffic level must be at most 1.75, got 99"),
+        (["--traffic", "99"], "traffic_level: traffic level must be at most 2, got 99"),
     ],
 )
 def test_ride_settings(tmp_path: Path, option: list[str], message: str) -> None:
@@ -94,7 +94,7 @@ def test_train_refuses_a_traffic_level_the_scenario_cannot_carry(tmp_path: Path)
     args = ("train", "--mode", "fast", "--set", "traffic_levels=[99]", "--no-progress")
     line = one_error_line(run(*args, "--out", "run", cwd=tmp_path))
     assert line == (
-        "error: invalid training config: traffic_levels.0: traffic level must be at most 1.75, "
+        "error: invalid training config: traffic_levels.0: traffic level must be at most 2, "
         "got 99: on a busier road the ego cannot enter"
     )
     assert not (tmp_path / "run").exists()  # refused when read: no workers, no run folder

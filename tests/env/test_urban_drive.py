@@ -322,3 +322,13 @@ def test_reset_option_sets_the_episode_noise(make_env):
     np.testing.assert_array_equal(obs_a, obs_b)  # the same seed, the same noise
     _, info = env.reset(seed=4)
     assert "true_obs" not in info
+
+
+def test_the_ego_enters_the_busiest_road(make_env) -> None:
+    # level 2.0: 1800 veh/h towards J1, whose main green passes about 1100; when the entry
+    # is cleared after 10 s, the cars waiting to enter there are dropped too, so the ego
+    # enters in the step after that clear: 11 steps of waiting, then 1 (seed 7 stayed
+    # blocked for 60 s without that rule)
+    env = make_env(traffic_level=2.0, max_steps=5)
+    env.reset(seed=7)
+    assert env.sumo.simulation.getTime() == 180 + 12

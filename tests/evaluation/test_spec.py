@@ -52,7 +52,7 @@ def test_levels() -> None:
     assert parse_levels("0.5,0.75,1.0,1.25,1.5") == (0.5, 0.75, 1.0, 1.25, 1.5)
     for text, message in [("x", "not a number"), ("0", "> 0"), ("-1", "> 0"),
                           ("nan", "finite"), ("1,1.0", "repeats"),
-                          ("1.8", "at most 1.75")]:  # fmt: skip
+                          ("2.1", "at most 2, got 2.1")]:  # fmt: skip
         with pytest.raises(SpecError, match=message):
             parse_levels(text)
 

@@ -41,7 +41,7 @@ from explaindrive.sim.scenario.layout import MAX_TRAFFIC_LEVEL, SEED_LIMIT
         ),
         (
             {"traffic_level": 99.0},
-            "traffic_level: traffic level must be at most 1.75, got 99: "
+            "traffic_level: traffic level must be at most 2, got 99: "
             "on a busier road the ego cannot enter",
         ),
         ({"traffic_level": 0.0}, "traffic_level: traffic level must be > 0, got 0"),
@@ -85,6 +85,6 @@ def test_defaults_and_accepted_edges() -> None:
         traffic_level=MAX_TRAFFIC_LEVEL,
     )
     assert (cfg.max_steps, cfg.interpret_deadline_s, cfg.backend) == (600, 2.0, "openai")
-    assert (cfg.seed, cfg.explain_deadline_s, cfg.traffic_level) == (2**31 - 1, 0.0, 1.75)
+    assert (cfg.seed, cfg.explain_deadline_s, cfg.traffic_level) == (2**31 - 1, 0.0, 2.0)
     assert RideConfig(traffic_level=1).traffic_level == 1.0
     assert cfg.replace(seed=3) == RideConfig.from_dict({**cfg.to_dict(), "seed": 3})

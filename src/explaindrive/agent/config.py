@@ -39,6 +39,7 @@ from explaindrive.config import (
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
 from explaindrive.env.noise import NoiseSD
 from explaindrive.env.reward import REWARD_NAMES
+from explaindrive.sim.scenario.choice import ScenarioFields
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 TRAIN_MODES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
@@ -49,7 +50,7 @@ Fraction = Annotated[float, Field(ge=0.0, le=1.0)]  # a probability or a share
 Range = Annotated[tuple[float, float], FROM_LIST]  # [min, max], 0 < min <= max
 
 
-class TrainConfig(ConfigModel):
+class TrainConfig(ConfigModel, ScenarioFields):
     """Everything that defines one training run of a D3QN driving agent.
 
     Step counts (``*_steps``, ``learning_starts``, ``train_frequency``) are counted in

@@ -17,7 +17,7 @@ from __future__ import annotations
 import functools
 import logging
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -50,13 +50,15 @@ def reseed(seed: int, attempt: int) -> int:
 def make_urban_drive_env(
     max_steps: int | None = None,
     yellow_leader: str = DEFAULT_YELLOW_LEADER,
+    scenario: Mapping[str, Any] | None = None,
     reward: str = "paper",
 ) -> gym.Env:
-    """The project's SUMO environment (imported lazily: each worker builds its own)."""
+    """The project's SUMO environment (imported lazily: each worker builds its own) in the
+    ``scenario`` chosen by these env config fields (the paper's road by default)."""
     from explaindrive.env.config import EnvConfig
     from explaindrive.env.urban_drive import UrbanDriveEnv
 
-    config = EnvConfig(yellow_leader=yellow_leader, reward=reward)
+    config = EnvConfig(yellow_leader=yellow_leader, reward=reward, **dict(scenario or {}))
     return UrbanDriveEnv(
         config=config if max_steps is None else config.replace(max_steps=max_steps)
     )
@@ -65,7 +67,11 @@ def make_urban_drive_env(
 def default_env_factory(config: TrainConfig) -> EnvFactory:
     """Picklable factory of the real environment for ``config``."""
     return functools.partial(
-        make_urban_drive_env, config.max_episode_steps, config.yellow_leader, config.reward
+        make_urban_drive_env,
+        config.max_episode_steps,
+        config.yellow_leader,
+        config.scenario_fields(),
+        config.reward,
     )
 
 

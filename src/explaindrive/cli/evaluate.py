@@ -9,7 +9,8 @@ import typer
 from rich.console import Console
 
 from explaindrive.cli import _grid_options as grid
-from explaindrive.cli._errors import error_line
+from explaindrive.cli import _scenario_options as where
+from explaindrive.cli._errors import error_line, print_error
 from explaindrive.cli._grid_options import err_console
 from explaindrive.evaluation.paper import PAPER_SEEDS
 
@@ -46,6 +47,14 @@ ObsNoiseOption = Annotated[
 EpisodesOption = Annotated[
     bool, typer.Option("--episodes/--no-episodes", help="Also print one row per episode.")
 ]
+ScenariosOption = Annotated[
+    str | None,
+    typer.Option(
+        "--scenarios",
+        help="Generated scenarios held out from training, e.g. random:100-119: tables per "
+        "scenario and overall.",
+    ),
+]
 
 
 def evaluate_command(
@@ -65,6 +74,11 @@ def evaluate_command(
     shield: grid.ShieldOption = True,
     episodes: EpisodesOption = True,
     obs_noise: ObsNoiseOption = None,
+    scenario: where.ScenarioOption = None,
+    scenarios: ScenariosOption = None,
+    net: where.NetOption = None,
+    route: where.RouteOption = None,
+    demand: where.DemandOption = None,
 ) -> None:
     """Evaluate a policy or a SUMO baseline; prints Markdown tables in the paper's layout."""
     from explaindrive.env.noise import parse_noise
@@ -86,20 +100,72 @@ def evaluate_command(
             stop_schedule=stop_schedule, commands=commands, max_steps=max_steps,
             obs_noise=(noise.sd_m, noise.sd_mps) if noise else (0.0, 0.0),
         )  # fmt: skip
-    except ValueError as exc:
-        err_console.print(error_line(exc))
+        plan = _in_scenarios(plan, scenario, scenarios, net, route, demand)
+    except (ValueError, where.ScenarioChoiceError) as exc:
+        print_error(err_console, exc)
         raise typer.Exit(2) from None
     if (problem := grid.check_ray_target(ray, ray_address)) is not None:
         err_console.print(error_line(problem))
         raise typer.Exit(2)
     records = _run(plan, workers, ray, ray_address)
-    _print_tables(plan.name, spec, records, episodes)
+    _print_scenario_tables(plan.name, spec, records, episodes)
     if json_file is not None:
         write_json(json_file, [run_document(plan.name, records)])
         err_console.print(f"wrote {json_file}")
     if figures is not None:
         for path in _write_figures(plan, spec, records, figures):
             err_console.print(f"wrote {path}")
+
+
+def _in_scenarios(
+    plan: RunPlan,
+    scenario: str | None,
+    scenarios: str | None,
+    net: Path | None,
+    route: str | None,
+    demand: Path | None,
+) -> RunPlan:
+    """The plan in the chosen scenario(s); generated ones are built here, once.
+
+    Raises:
+        SpecError, ScenarioChoiceError: naming the problem.
+    """
+    from explaindrive.cache import cache_dir
+    from explaindrive.evaluation.scenarios import (
+        ScenarioCase,
+        network_case,
+        over_scenarios,
+        parse_scenarios,
+    )
+    from explaindrive.sim.network import parse_route
+
+    fields = where.scenario_fields(scenario, net, route, demand)
+    if scenarios is not None:
+        if fields:
+            raise where.ScenarioChoiceError("give --scenarios or one scenario, not both")
+        return over_scenarios(plan, parse_scenarios(scenarios, cache_dir()))
+    if not fields:
+        return plan
+    if scenario is not None:
+        case = ScenarioCase(Path(scenario).name, tuple(fields.items()))
+    else:
+        assert net is not None and route is not None
+        case = network_case(f"{net.name}:{'->'.join(parse_route(route))}", fields)
+    return over_scenarios(plan, [case])
+
+
+def _print_scenario_tables(name: str, spec: PolicySpec, records: list[Any], episodes: bool) -> None:
+    """The tables per scenario, then over all of them (one scenario: its tables only)."""
+    from explaindrive.evaluation.scenarios import by_scenario
+
+    groups = by_scenario(records)
+    if len(groups) > 1:
+        for scenario_name, recs in groups.items():
+            _print_tables(f"{name} on {scenario_name}", spec, recs, episodes)
+        name = f"{name} overall ({len(groups)} scenarios)"
+    elif records and records[0].spec.scenario_name != "paper":
+        name = f"{name} on {records[0].spec.scenario_name}"
+    _print_tables(name, spec, records, episodes and len(groups) == 1)
 
 
 def _run(plan: RunPlan, workers: int | None, ray: bool, ray_address: str | None) -> list[Any]:

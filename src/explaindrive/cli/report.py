@@ -42,6 +42,13 @@ SeedTableOption = Annotated[
     list[Path] | None,
     typer.Option("--seed-table", help="A seeds.md of train --seeds to include (repeatable)."),
 ]
+GeneralisationOption = Annotated[
+    bool,
+    typer.Option(
+        "--generalisation/--no-generalisation",
+        help="Add the table on 20 held-out generated scenarios and two netgenerate networks.",
+    ),
+]
 
 
 def report_command(
@@ -60,6 +67,7 @@ def report_command(
     ray_address: grid.RayAddressOption = None,
     max_steps: grid.MaxStepsOption = 1000,
     seed_tables: SeedTableOption = None,
+    generalisation: GeneralisationOption = True,
 ) -> None:
     """Evaluate the policies and baselines and rewrite the results document and figures."""
     from explaindrive.evaluation.report import run_report
@@ -75,10 +83,29 @@ def report_command(
             command_line="explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
             progress=progress, seed_tables=seed_tables or [],
         )  # fmt: skip
+    markdown = result.markdown
+    if generalisation:
+        markdown += _generalisation(plan, max_steps, workers, ray, ray_address)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(result.markdown, encoding="utf-8")
+    out.write_text(markdown, encoding="utf-8")
     for path in (out, *result.figures):
         err_console.print(f"wrote {path}")
+
+
+def _generalisation(
+    plan: ReportPlan, max_steps: int, workers: int | None, ray: bool, ray_address: str | None
+) -> str:
+    """The generalisation section (:mod:`explaindrive.evaluation.generalisation`)."""
+    from explaindrive.cache import cache_dir
+    from explaindrive.evaluation import generalisation as gen
+
+    plans = gen.plan_generalisation(plan.policies, gen.scenario_groups(cache_dir()),
+                                    max_steps=max_steps)  # fmt: skip
+    n = sum(len(p.episodes) for p in plans.values())
+    err_console.print(f"generalisation: {n} episodes")
+    with grid.episode_progress("generalisation", n) as progress:
+        return gen.run_generalisation(plans, workers=workers, use_ray=ray,
+                                      ray_address=ray_address, progress=progress)  # fmt: skip
 
 
 def _plan(

@@ -23,6 +23,7 @@ import typer
 from rich.console import Console
 from rich.live import Live
 
+from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
 from explaindrive.language.config import LanguageConfig
@@ -113,6 +114,10 @@ def ride(
     fast_policy: FastPolicyOption = None,
     comfort_policy: ComfortPolicyOption = None,
     obs_noise: ObsNoiseOption = None,
+    scenario: where.ScenarioOption = None,
+    net: where.NetOption = None,
+    route: where.RouteOption = None,
+    demand: where.DemandOption = None,
 ) -> None:
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     if voice and not interactive:
@@ -131,6 +136,7 @@ def ride(
             fast_policy=fast_policy,
             comfort_policy=comfort_policy,
             obs_noise=_noise(obs_noise),
+            **where.scenario_fields(scenario, net, route, demand),
         )
         language_config = LanguageConfig()
         lines = _script_lines(script, interactive, max_steps)

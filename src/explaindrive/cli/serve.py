@@ -5,6 +5,7 @@ from __future__ import annotations
 import typer
 from rich.console import Console
 
+from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
 from explaindrive.language.backends import check_backend
@@ -35,6 +36,10 @@ def serve(
     ),
     fast_policy: FastPolicyOption = None,
     comfort_policy: ComfortPolicyOption = None,
+    scenario: where.ScenarioOption = None,
+    net: where.NetOption = None,
+    route: where.RouteOption = None,
+    demand: where.DemandOption = None,
 ) -> None:
     """Serve the passenger page: watch the ride, talk to the car, read its explanations."""
     import uvicorn
@@ -50,6 +55,7 @@ def serve(
         check_installed()
         if fast_policy is not None or comfort_policy is not None:  # loads them once to check
             MergedController.from_package(fast=fast_policy, comfort=comfort_policy)
+        place = where.scenario_fields(scenario, net, route, demand)
     except (FileNotFoundError, ValueError, CheckpointError) as exc:
         print_error(console, exc)
         raise typer.Exit(2) from exc
@@ -59,8 +65,8 @@ def serve(
             f"[yellow]warning:[/yellow] binding {host} exposes the ride controls to the network"
         )
     console.print(f"answering Host names: {', '.join(sorted(hosts))}", highlight=False)
-    stack = RealStack(backend, fast_policy, comfort_policy)
-    app = create_app(stack, step_period_s=step_period, hosts=hosts)
+    stack = RealStack(backend, fast_policy, comfort_policy, place)
+    app = create_app(stack, step_period_s=step_period, hosts=hosts, net_file=where.net_of(place))
     console.print(f"passenger page: http://{host}:{port}/  (Ctrl+C to stop)")
     uvicorn.run(app, host=host, port=port, log_level="warning")
 

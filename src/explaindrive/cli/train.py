@@ -19,6 +19,7 @@ from explaindrive.agent.config import (
     load_config_file,
     parse_override,
 )
+from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import check_ray_target
 
@@ -130,14 +131,24 @@ def train_command(
     ray: WorkerRayOption = False,
     ray_address: WorkerRayAddressOption = None,
     seeds: SeedsOption = None,
+    scenario: where.ScenarioOption = None,
+    net: where.NetOption = None,
+    route: where.RouteOption = None,
+    demand: where.DemandOption = None,
 ) -> None:
     """Train a D3QN driving agent with the paper's command schedule."""
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.trainer import Trainer
 
+    try:
+        place = where.scenario_fields(scenario, net, route, demand, allow_random=True)
+    except where.ScenarioChoiceError as exc:
+        print_error(console, exc)
+        raise typer.Exit(2) from None
     if seeds is not None:
         run_args = seed_run_args(mode, episodes, envs, resume, preset, config_file,
                                  overrides or [], ray, ray_address)  # fmt: skip
+        run_args += where.scenario_args(scenario, net, route, demand)
         _train_seeds(mode, seeds, seed, out, run_args)
         return
     out = out or Path("runs") / mode
@@ -146,7 +157,7 @@ def train_command(
             raise ConfigError(problem)
         config = resolve_config(
             mode.strip().lower(), preset, config_file, overrides or [], out, resume,
-            episodes=episodes, num_envs=envs, seed=seed,
+            episodes=episodes, num_envs=envs, seed=seed, **place,
         )  # fmt: skip
         trainer = Trainer(config, out, resume=resume, show_progress=progress, use_ray=ray,
                           ray_address=ray_address)  # fmt: skip

@@ -11,11 +11,12 @@ from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
 from explaindrive.env.noise import NoiseSD, ObservationNoise
 from explaindrive.env.reward import REWARD_NAMES
+from explaindrive.sim.scenario.choice import ScenarioFields
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
 
-class EnvConfig(ConfigModel):
+class EnvConfig(ConfigModel, ScenarioFields):
     """Settings of :class:`~explaindrive.env.urban_drive.UrbanDriveEnv`.
 
     Attributes:
@@ -23,7 +24,8 @@ class EnvConfig(ConfigModel):
         max_steps: step limit of an episode (truncation) [steps of 1 s].
         warmup_s: simulated time before the ego enters [s]; the state is cached.
         normalize_obs: return observations scaled into [-1, 1] (see ``env.state``).
-        net_file: a SUMO network to use instead of the shipped scenario.
+        scenario, scenario_every, net_file, route, demand_file: where the ego drives
+            (:class:`~explaindrive.sim.scenario.choice.ScenarioFields`).
         cache_dir: where generated demand files and warm-up states are kept.
         insert_timeout_s: how long the ego may wait for space to enter [s].
         ego_model: ``"agent"`` (the action sets the speed, SUMO's checks off) or a SUMO
@@ -46,7 +48,6 @@ class EnvConfig(ConfigModel):
     max_steps: PositiveInt = 1000
     warmup_s: NonNegativeInt = 180
     normalize_obs: bool = False
-    net_file: TextPath | None = None
     cache_dir: TextPath | None = None
     insert_timeout_s: PositiveInt = 60
     ego_model: Annotated[str, one_of(EGO_MODELS)] = "agent"

@@ -9,12 +9,8 @@ from __future__ import annotations
 
 import logging
 import math
-import os
-import subprocess
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -44,29 +40,31 @@ from explaindrive.env.reward import (
     time_headway,
     time_to_collision,
 )
+from explaindrive.env.warm_start import restore_warm_state, sumo_args
 from explaindrive.sim.connection import SumoConnection
 from explaindrive.sim.crossing_lanes import CrossingLane, crossing_lanes, pedestrian_in_lane
 from explaindrive.sim.pedestrians import KerbYield, PedestrianSource
-from explaindrive.sim.route import RouteCrossing, RouteGeometry, load_route_geometry
+from explaindrive.sim.route import RouteCrossing, RouteGeometry, RouteLight, load_route_geometry
 from explaindrive.sim.scenario.files import (
     BASELINE_EGO_TYPES,
     EGO_ID,
     EGO_ROUTE_ID,
     EGO_TYPE_ID,
     ScenarioFiles,
-    default_scenario,
 )
-from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES, SEED_LIMIT, validate_seed
-from explaindrive.sim.sumo_home import sumo_binary
+from explaindrive.sim.scenario.limits import SATURATED_LEVEL, SEED_LIMIT, validate_seed
+from explaindrive.sim.scenario.source import ScenarioSource
 
 log = logging.getLogger(__name__)
 
 _EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER)
+_EGO_LANE_VARS = (*_EGO_VARS, tc.VAR_LANE_ID)  # where SUMO changes the ego's lanes
 _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
 JUDGE_CROSSING_M = S.MAX_SPEED_MPS + 5.0  # [m] a crossing this close may be entered next step
+STRATEGIC_LANE_CHANGES = 0b011000000001  # SUMO lane-change mode: strategic changes only
 _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
 _HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
 
@@ -131,6 +129,7 @@ class _Episode:
     amber: AmberDecision = field(default_factory=AmberDecision)
     noise: ObservationNoise = field(default_factory=ObservationNoise)
     noise_rng: np.random.Generator = field(default_factory=lambda: np.random.default_rng(0))
+    lane_id: str | None = None  # the ego's lane, read where SUMO changes its lanes
 
 
 class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
@@ -164,14 +163,14 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             cfg = EnvConfig.from_mapping({**dict(config or {}), **overrides})
         self.config = cfg
         self.render_mode = render_mode
-        cache = cfg.cache_dir or user_cache_dir()
-        self.scenario: ScenarioFiles = (
-            ScenarioFiles(net_file=cfg.net_file, cache_dir=cache)
-            if cfg.net_file
-            else default_scenario(cache)
+        self._scenarios = ScenarioSource(
+            cfg.cache_dir or user_cache_dir(), cfg.scenario, cfg.net_file, cfg.route,
+            cfg.demand_file, cfg.scenario_every,
+        )  # fmt: skip
+        self.scenario: ScenarioFiles = self._scenarios.current
+        self.geometry: RouteGeometry = load_route_geometry(
+            self.scenario.net_file, self.scenario.route_edges
         )
-        self.scenario.check()
-        self.geometry: RouteGeometry = load_route_geometry(self.scenario.net_file, EGO_ROUTE_EDGES)
         self._crossing_lanes: dict[str, CrossingLane] = crossing_lanes(
             self.scenario.net_file, _approach_edges(self.geometry)
         )
@@ -234,10 +233,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         level = opts.traffic_level if opts.traffic_level is not None else self.config.traffic_level
         sumo_seed = seed if seed is not None else int(self.np_random.integers(0, SEED_LIMIT - 1))
         validate_seed(sumo_seed)
+        self._use_scenario(self._scenarios.for_episode(int(sumo_seed)))
         try:
-            self._conn.start_or_load(self._sumo_args(level, int(sumo_seed)))
-            self._restore_warm_state(level, int(sumo_seed))
-            start_pos = self._insert_ego()
+            self._conn.start_or_load(sumo_args(self.scenario, level, int(sumo_seed)))
+            restore_warm_state(self._conn.api, self.scenario, level, int(sumo_seed),
+                               self.config.warmup_s)  # fmt: skip
+            start_pos = self._insert_ego(drop_backlog=level > SATURATED_LEVEL)
         except BaseException:
             self.close()
             raise
@@ -246,7 +247,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             command=opts.command,
             schedule=schedule,
             start_pos_m=start_pos,
-            pedestrians=PedestrianSource(int(sumo_seed), horizon_s=self.config.max_steps + 1.0),
+            pedestrians=PedestrianSource(
+                int(sumo_seed), self.config.max_steps + 1.0, self.scenario.pedestrian_flows
+            ),
             amber=AmberDecision(always=self.config.yellow_leader == "always"),
             noise=opts.noise if opts.noise is not None else self.config.noise,
             noise_rng=np.random.default_rng([int(sumo_seed), 17]),
@@ -257,6 +260,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         obs, _leader, _ = self._observe(api, api.vehicle.getSubscriptionResults(EGO_ID))
         self._last_obs = obs
         info = {
+            "scenario": self.scenario.name,
             "command": self._ep.command.label,
             "traffic_level": level,
             "seed": int(sumo_seed),
@@ -423,72 +427,17 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise RuntimeError("no episode is running; call reset() first")
         return self._ep
 
-    def _sumo_args(self, level: float, seed: int) -> list[str]:
-        return [
-            "-n",
-            str(self.scenario.net_file),
-            "-r",
-            str(self.scenario.routes_file(level)),
-            "--seed",
-            str(seed),
-            "--step-length",
-            str(STEP_LENGTH_S),
-            "--no-step-log",
-            "true",
-            "--no-warnings",
-            "true",
-            "--collision.action",
-            "remove",
-            "--collision.check-junctions",
-            "true",
-            "--collision.mingap-factor",
-            "0",
-            "--save-state.rng",
-            "true",
-            "--time-to-teleport",
-            "-1",
-        ]
-
-    def _state_file(self, level: float, seed: int) -> Path:
-        demand = self.scenario.routes_file(level).name.removesuffix(".rou.xml")  # level + hash
-        return self.scenario.state_dir() / f"{demand}_seed{seed}_warm{self.config.warmup_s}.xml"
-
-    def _restore_warm_state(self, level: float, seed: int) -> None:
-        """Continue from the cached warm-up state of (level, seed), creating it if needed."""
-        if self.config.warmup_s == 0:
+    def _use_scenario(self, scenario: ScenarioFiles) -> None:
+        """Drive the next episodes in ``scenario`` (a new draw under domain randomisation)."""
+        if scenario is self.scenario:
             return
-        path = self._state_file(level, seed)
-        if not path.exists():
-            self._write_warm_state(level, seed, path)
-        self._conn.api.simulation.loadState(str(path))
+        self.scenario = scenario
+        self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges)
+        self._crossing_lanes = crossing_lanes(scenario.net_file, _approach_edges(self.geometry))
+        self._tls_link = {}
+        self._conn.close()  # the next episode starts SUMO on the new network
 
-    def _write_warm_state(self, level: float, seed: int, path: Path) -> None:
-        """Simulate the warm-up in a fresh ``sumo`` process and save its state.
-
-        A separate process keeps the result independent of whatever this process
-        simulated before (libsumo keeps some random state across restarts).
-        """
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".xml")
-        os.close(fd)
-        warmup = str(self.config.warmup_s)
-        args = [
-            sumo_binary("sumo"),
-            *self._sumo_args(level, seed),
-            "--end",
-            str(self.config.warmup_s + 1),
-            "--save-state.times",
-            warmup,
-            "--save-state.files",
-            tmp,
-        ]
-        proc = subprocess.run(args, capture_output=True, text=True, check=False)
-        if proc.returncode != 0:
-            Path(tmp).unlink(missing_ok=True)
-            raise RuntimeError(f"SUMO warm-up failed ({proc.returncode}): {proc.stderr[-2000:]}")
-        os.replace(tmp, path)
-
-    def _insert_ego(self) -> float:
+    def _insert_ego(self, drop_backlog: bool = False) -> float:
         api = self._conn.api
         model = self.config.ego_model
         type_id = EGO_TYPE_ID if model == "agent" else BASELINE_EGO_TYPES[model]
@@ -506,19 +455,21 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             if EGO_ID in api.simulation.getDepartedIDList():
                 break
             if waited and waited % ENTRY_CLEAR_AFTER_S == 0:
-                self._clear_entry()
+                self._clear_entry(drop_backlog)
         else:
             raise RuntimeError(
                 f"the ego could not enter within {self.config.insert_timeout_s} s "
                 "(the first road stays blocked); lower the traffic level"
             )
-        api.vehicle.setLaneChangeMode(EGO_ID, 0)
+        lane_changes = STRATEGIC_LANE_CHANGES if self.scenario.strategic_lane_changes else 0
+        api.vehicle.setLaneChangeMode(EGO_ID, lane_changes)
         self._ego_min_gap_m = float(api.vehicle.getMinGap(EGO_ID))
         self._ego_length_m = float(api.vehicle.getLength(EGO_ID))
         if model == "agent":
             api.vehicle.setSpeedMode(EGO_ID, 0)  # no car-following, light or right-of-way checks
             api.vehicle.setSpeed(EGO_ID, 0.0)
-        api.vehicle.subscribe(EGO_ID, _EGO_VARS, parameters={tc.VAR_LEADER: S.SENSOR_RANGE_M})
+        ego_vars = _EGO_LANE_VARS if self.scenario.strategic_lane_changes else _EGO_VARS
+        api.vehicle.subscribe(EGO_ID, ego_vars, parameters={tc.VAR_LEADER: S.SENSOR_RANGE_M})
         if not self._tls_link:
             self._tls_link = {t[0]: int(t[1]) for t in api.vehicle.getNextTLS(EGO_ID)}
         for tls_id in self._tls_link:
@@ -529,11 +480,18 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
                 api.edge.subscribe(edge, (tc.LAST_STEP_PERSON_ID_LIST,))
         return float(api.vehicle.getLanePosition(EGO_ID))
 
-    def _clear_entry(self) -> None:
-        """Remove background vehicles from the ego's entry stretch (oversaturated demand)."""
+    def _clear_entry(self, drop_backlog: bool) -> None:
+        """Remove background vehicles from the ego's entry stretch (oversaturated demand), and
+        with ``drop_backlog`` those still waiting to enter there, which SUMO would insert
+        before the ego."""
         api = self._conn.api
-        lane = f"{EGO_ROUTE_EDGES[0]}_1"
-        for vid in api.lane.getLastStepVehicleIDs(lane):
+        edge = self.scenario.route_edges[0]
+        if drop_backlog:
+            for vid in api.simulation.getPendingVehicles():
+                if vid != EGO_ID and api.vehicle.getRoute(vid)[0] == edge:
+                    api.vehicle.remove(vid)
+        lanes = [f"{edge}_{i}" for i in range(api.edge.getLaneNumber(edge))]
+        for vid in (v for lane in lanes for v in api.lane.getLastStepVehicleIDs(lane)):
             if vid != EGO_ID and api.vehicle.getLanePosition(vid) < ENTRY_CLEAR_M:
                 api.vehicle.remove(vid)
         log.debug("cleared the ego's entry stretch after %d s without a gap", ENTRY_CLEAR_AFTER_S)
@@ -596,6 +554,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         """
         ep = self._episode()
         v = float(ego[tc.VAR_SPEED])
+        ep.lane_id = ego.get(tc.VAR_LANE_ID)
         rng = S.SENSOR_RANGE_M
         real = self._real_leader(api, ego)
         leader = real
@@ -646,14 +605,19 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             if ahead < 0.0 or light.tls_id not in self._tls_link:
                 continue
             states = api.trafficlight.getSubscriptionResults(light.tls_id)
-            colour = S.LightState.from_sumo(
-                states[tc.TL_RED_YELLOW_GREEN_STATE][self._tls_link[light.tls_id]]
-            )
+            colour = S.LightState.from_sumo(states[tc.TL_RED_YELLOW_GREEN_STATE][self._link(light)])
             ep.light_state[light.tls_id] = colour
             if ahead < S.SENSOR_RANGE_M:
                 d_tl, tls, light_id = ahead, colour, light.tls_id
             break
         return d_tl, tls, light_id
+
+    def _link(self, light: RouteLight) -> int:
+        """The ego's link at ``light``: the one from the lane it is on when that lane
+        approaches the light, else the one it was routed through at entry."""
+        lane = self._episode().lane_id
+        index = light.link_of(lane) if lane is not None else None
+        return self._tls_link[light.tls_id] if index is None else index
 
     def _next_busy_crossing(self, pos: float) -> float:
         """Distance to the nearest crossing a pedestrian is on or entering (range if none);
@@ -683,7 +647,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         for light in self.geometry.lights:
             if prev_pos < light.stop_line_m <= pos and light.tls_id in self._tls_link:
                 states = self._conn.api.trafficlight.getSubscriptionResults(light.tls_id)
-                char = states[tc.TL_RED_YELLOW_GREEN_STATE][self._tls_link[light.tls_id]]
+                char = states[tc.TL_RED_YELLOW_GREEN_STATE][self._link(light)]
                 return S.LightState.from_sumo(char) is S.LightState.RED
         return False
 

@@ -92,6 +92,7 @@ def run_episode(spec: EpisodeSpec) -> EpisodeRecord:
         max_steps=spec.max_steps,
         ego_model=policy.ego_model,
         obs_noise=spec.obs_noise if policy.kind != "baseline" else (0.0, 0.0),
+        **dict(spec.scenario),
     )
     if driver is not None:  # a network drives in the environment it was trained in
         config = config.replace(yellow_leader=driver.yellow_leader)

@@ -20,6 +20,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from explaindrive.commands import COMMAND_LABELS, Command
 from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
@@ -82,6 +83,8 @@ class EpisodeSpec:
         max_steps: step limit [steps of 1 s].
         obs_noise: ``(sd_m, sd_mps)`` of the noise on what the driver sees
             (:mod:`explaindrive.env.noise`); SUMO's drivers see the true state.
+        scenario: env config fields choosing the scenario (none: the paper's road).
+        scenario_name: how tables name that scenario.
     """
 
     policy: PolicySpec
@@ -91,6 +94,8 @@ class EpisodeSpec:
     schedule: tuple[tuple[float, str], ...]
     max_steps: int = DEFAULT_MAX_STEPS
     obs_noise: tuple[float, float] = (0.0, 0.0)
+    scenario: tuple[tuple[str, Any], ...] = ()
+    scenario_name: str = "paper"
 
 
 # ---------------------------------------------------------------------------- text parsers

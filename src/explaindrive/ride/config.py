@@ -9,13 +9,14 @@ from pydantic import AfterValidator, Field, NonNegativeFloat, PositiveInt
 from explaindrive.config import ConfigModel, Seed, TextPath, TrafficLevel
 from explaindrive.env.noise import NoiseSD
 from explaindrive.language.backends import check_backend
+from explaindrive.sim.scenario.choice import ScenarioFields
 
 
-class RideConfig(ConfigModel):
+class RideConfig(ConfigModel, ScenarioFields):
     """Settings of :class:`~explaindrive.ride.session.RideSession`.
 
     Attributes:
-        traffic_level: demand scale, in (0, 1.75] (1.0 = 900 veh/h on the main road).
+        traffic_level: demand scale, in (0, 2] (1.0 = 900 veh/h on the main road).
         seed: simulation seed.
         max_steps: longest ride [steps of 1 s].
         backend: language backend (``embedded`` or ``openai``).

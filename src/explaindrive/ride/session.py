@@ -148,6 +148,7 @@ class RideSession:
             max_steps=config.max_steps,
             yellow_leader=controller.yellow_leader,  # the networks' own rule
             obs_noise=config.obs_noise,
+            **config.scenario_fields(),
             render_mode="human" if config.gui else None,
         )
         self.lane = LanguageLane()

@@ -68,7 +68,9 @@ class SumoConnection:
         try:
             libsumo.start([sumo_binary("sumo"), *args])
         except Exception as exc:  # libsumo raises its own TraCIException
-            raise SumoConnectionError(f"SUMO failed to start: {exc}") from exc
+            # SUMO's messages span lines ("... not known.\n The route can not be build.")
+            message = " ".join(str(exc).split())
+            raise SumoConnectionError(f"SUMO failed to start: {message}") from exc
         SumoConnection._libsumo_owner = self
         self._api = libsumo
 

@@ -8,6 +8,7 @@ include the internal (junction) lanes, so they match SUMO's odometer.
 from __future__ import annotations
 
 import bisect
+import itertools
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +22,17 @@ class RouteLight:
 
     tls_id: str
     stop_line_m: float  # [m] route position of the stop line
+    lane_links: tuple[tuple[str, int], ...] = ()
+    """(approach lane, index of its link in the light's state) for every lane that leads on
+    along the route (several on a multi-lane road)."""
+
+    def link_of(self, lane_id: str) -> int | None:
+        """The index of the link the ego follows from ``lane_id`` (``None``: not an
+        approach lane of this light)."""
+        for lane, index in self.lane_links:
+            if lane == lane_id:
+                return index
+        return None
 
 
 @dataclass(frozen=True, slots=True)
@@ -82,9 +94,13 @@ def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGe
     edge_to = {e.attrib["id"]: e.get("to") for e in root.iter("edge") if not e.get("function")}
     nodes = {j.attrib["id"]: j for j in root.iter("junction")}
     lights = [
-        RouteLight(tls_id=nodes[edge_to[eid] or ""].attrib["id"], stop_line_m=layout.end[eid])
-        for eid in route_edges[:-1]
-        if nodes[edge_to[eid] or ""].get("type") == "traffic_light"
+        RouteLight(
+            tls_id=tls_id,
+            stop_line_m=layout.end[eid],
+            lane_links=tuple(net.links.get((eid, nxt), ())),
+        )
+        for eid, nxt in itertools.pairwise(route_edges)
+        if (tls_id := net.conns[(eid, nxt)].get("tl"))
     ]
     crossings = _route_crossings(root, route_edges, edge_to, nodes, layout)
     return RouteGeometry(
@@ -106,17 +122,21 @@ class _Network:
     edge_lane: dict[str, str]  # normal edge -> its vehicle lane
     conns: dict[tuple[str, str], ET.Element]  # (edge, next edge) -> connection with a via lane
     via_next: dict[str, str]  # internal lane -> the next internal lane
+    links: dict[tuple[str, str], list[tuple[str, int]]]  # (edge, next) -> signalled links
 
     @classmethod
     def read(cls, root: ET.Element) -> _Network:
         edge_lane: dict[str, str] = {}
+        car_lanes: set[str] = set()
         for edge in root.iter("edge"):
             if edge.get("function"):
                 continue
             for lane in edge.iter("lane"):
-                if "pedestrian" not in (lane.get("allow") or "").split():
-                    edge_lane[edge.attrib["id"]] = lane.attrib["id"]  # the vehicle lane
+                if _allows_cars(lane):
+                    car_lanes.add(lane.attrib["id"])
+                    edge_lane[edge.attrib["id"]] = lane.attrib["id"]  # the leftmost car lane
         conns: dict[tuple[str, str], ET.Element] = {}
+        links: dict[tuple[str, str], list[tuple[str, int]]] = {}
         via_next: dict[str, str] = {}
         for c in root.iter("connection"):
             src, dst = c.attrib["from"], c.attrib["to"]
@@ -124,11 +144,22 @@ class _Network:
                 if c.get("via"):
                     via_next[f"{src}_{c.attrib['fromLane']}"] = c.attrib["via"]
                 continue
-            if dst in edge_lane and c.get("via"):
-                lane_from = f"{src}_{c.attrib['fromLane']}"
-                if lane_from == edge_lane.get(src):
-                    conns[(src, dst)] = c
-        return cls(_lane_lengths(root), edge_lane, conns, via_next)
+            lane_from = f"{src}_{c.attrib['fromLane']}"
+            # the reference lane's connection, else the first car lane's (several lanes)
+            usable = dst in edge_lane and lane_from in car_lanes
+            if usable and (lane_from == edge_lane.get(src) or (src, dst) not in conns):
+                conns[(src, dst)] = c
+            if usable and c.get("tl") and c.get("linkIndex") is not None:
+                links.setdefault((src, dst), []).append((lane_from, int(c.attrib["linkIndex"])))
+        return cls(_lane_lengths(root), edge_lane, conns, via_next, links)
+
+
+def _allows_cars(lane: ET.Element) -> bool:
+    """Whether a lane of a normal edge carries passenger cars (not a sidewalk or bike lane)."""
+    allow, disallow = lane.get("allow"), lane.get("disallow")
+    if allow is not None:
+        return "passenger" in allow.split() or allow == "all"
+    return disallow is None or "passenger" not in disallow.split()
 
 
 @dataclass
@@ -160,7 +191,7 @@ def _lay_out(net: _Network, route_edges: tuple[str, ...], net_file: Path) -> _La
             conn = net.conns.get((eid, route_edges[i + 1]))
             if conn is None:
                 raise ValueError(f"no connection {eid} -> {route_edges[i + 1]} in {net_file}")
-            via: str | None = conn.attrib["via"]
+            via: str | None = conn.get("via")
             nxt_speed = net.lanes[net.edge_lane[route_edges[i + 1]]][1]
             if nxt_speed < speed:  # the lower limit starts at the junction
                 layout.zone_start.append(pos)

@@ -78,6 +78,8 @@ class RealStack:
         fast_policy: a fast network in place of the shipped one (a policy ``.pt`` file or
             a training run directory).
         comfort_policy: likewise for the comfort network.
+        scenario: ride config fields choosing where the rides drive (the paper's road by
+            default; see :class:`~explaindrive.sim.scenario.choice.ScenarioFields`).
     """
 
     def __init__(
@@ -85,9 +87,11 @@ class RealStack:
         backend: str = "embedded",
         fast_policy: Path | None = None,
         comfort_policy: Path | None = None,
+        scenario: dict[str, Any] | None = None,
     ) -> None:
         self.backend = check_backend(backend)
         self.policies = (fast_policy, comfort_policy)
+        self.scenario = dict(scenario or {})
         self._controller: Any = None
         self._language: Any = None
 
@@ -102,7 +106,8 @@ class RealStack:
             self._controller = MergedController.from_package(fast=fast, comfort=comfort)
         if self._language is None:
             self._language = make_language_stack(self.backend, LanguageConfig()).load()
-        config = config.replace(backend=self.backend, fast_policy=fast, comfort_policy=comfort)
+        config = config.replace(backend=self.backend, fast_policy=fast, comfort_policy=comfort,
+                                **self.scenario)  # fmt: skip
         return RideSession(config, self._controller, self._language)
 
 
@@ -114,6 +119,7 @@ def create_app(
     max_upload_bytes: int = MAX_UPLOAD_BYTES,
     max_audio_s: float = MAX_AUDIO_S,
     hosts: Iterable[str] = LOOPBACK_HOSTS,
+    net_file: Path | None = None,
 ) -> FastAPI:
     """Build the web app.
 
@@ -126,9 +132,10 @@ def create_app(
         max_audio_s: longest accepted recording, counted while it is decoded [s].
         hosts: the host names the server answers to (``Host`` header); the loopback
             names by default (see :func:`explaindrive.web.guard.served_hosts`).
+        net_file: the network the rides drive, which the page draws (default: the paper's).
     """
     factory = session_factory or RealStack(backend)
-    scene = load_scene(default_scenario().net_file)
+    scene = load_scene(net_file or default_scenario().net_file)
     manager = RideManager(factory, scene, step_period_s=step_period_s)
 
     @asynccontextmanager

@@ -20,7 +20,7 @@ class StartRequest(_Strict):
     """Start a new ride.
 
     Attributes:
-        traffic_level: demand scale, in (0, 1.75] (1.0 = 900 veh/h on the main road).
+        traffic_level: demand scale, in (0, 2] (1.0 = 900 veh/h on the main road).
         seed: simulation seed; the same seed and level give the same traffic.
         command: the command the car starts with.
         max_steps: longest ride [s].

@@ -1,9 +1,9 @@
 """Build the urban network with SUMO's own tools.
 
-Writes plain XML (nodes, edges, connections with crossings) from
-:mod:`explaindrive.sim.scenario.layout` and runs ``netconvert`` on it. The
-generated ``urban.net.xml`` is committed with the package, so running the
-scenario never needs ``netconvert``; rebuild with ``explaindrive scenario build``.
+Writes plain XML (nodes, edges, connections with crossings) of a
+:class:`~explaindrive.sim.scenario.layout.Layout` (the paper's road by default) and runs
+``netconvert`` on it. The paper's ``urban.net.xml`` is committed with the package, so
+running it never needs ``netconvert``; rebuild it with ``explaindrive scenario build``.
 """
 
 from __future__ import annotations
@@ -28,19 +28,19 @@ def _attrs(**kwargs: object) -> str:
     return " ".join(f"{k}={quoteattr(str(v))}" for k, v in kwargs.items())
 
 
-def nodes_xml() -> str:
+def nodes_xml(plan: layout.Layout = layout.PAPER_LAYOUT) -> str:
     """Plain node XML of the layout."""
     lines = ['<nodes version="1.20">']
-    for n in layout.NODES:
+    for n in plan.nodes:
         lines.append(f"    <node {_attrs(id=n.id, x=n.x, y=n.y, type=n.type)}/>")
     lines.append("</nodes>")
     return "\n".join(lines) + "\n"
 
 
-def edges_xml() -> str:
+def edges_xml(plan: layout.Layout = layout.PAPER_LAYOUT) -> str:
     """Plain edge XML: one edge per direction; streets get a vehicle lane and a sidewalk."""
     lines = ['<edges version="1.20">']
-    for road in layout.ROADS:
+    for road in plan.roads:
         for eid, a, b in ((road.forward, road.a, road.b), (road.backward, road.b, road.a)):
             if road.kind == "footpath":
                 attrs = _attrs(
@@ -67,11 +67,11 @@ def edges_xml() -> str:
     return "\n".join(lines) + "\n"
 
 
-def connections_xml() -> str:
+def connections_xml(plan: layout.Layout = layout.PAPER_LAYOUT) -> str:
     """Plain connection XML holding the pedestrian crossings."""
     lines = ['<connections version="1.20">']
     for node, edges in layout.CROSSINGS:
-        signalized = any(n.id == node and n.type == "traffic_light" for n in layout.NODES)
+        signalized = any(n.id == node and n.type == "traffic_light" for n in plan.nodes)
         attrs = _attrs(
             node=node,
             edges=" ".join(edges),
@@ -84,7 +84,7 @@ def connections_xml() -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_plain_xml(out_dir: Path) -> dict[str, Path]:
+def write_plain_xml(out_dir: Path, plan: layout.Layout = layout.PAPER_LAYOUT) -> dict[str, Path]:
     """Write the plain node/edge/connection files into ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     files = {
@@ -92,9 +92,9 @@ def write_plain_xml(out_dir: Path) -> dict[str, Path]:
         "edges": out_dir / EDGES_FILE,
         "connections": out_dir / CONNECTIONS_FILE,
     }
-    files["nodes"].write_text(nodes_xml())
-    files["edges"].write_text(edges_xml())
-    files["connections"].write_text(connections_xml())
+    files["nodes"].write_text(nodes_xml(plan))
+    files["edges"].write_text(edges_xml(plan))
+    files["connections"].write_text(connections_xml(plan))
     return files
 
 
@@ -133,21 +133,22 @@ def netconvert_args(files: dict[str, Path], net_file: Path) -> list[str]:
     ]
 
 
-def build_network(out_dir: Path) -> Path:
-    """Write the plain XML and run netconvert; returns the network file.
+def build_network(out_dir: Path, plan: layout.Layout = layout.PAPER_LAYOUT) -> Path:
+    """Write the plain XML of ``plan`` and run netconvert; returns the network file.
 
     Raises:
         RuntimeError: if netconvert fails (its stderr is included).
     """
-    files = write_plain_xml(out_dir)
+    files = write_plain_xml(out_dir, plan)
     net_file = out_dir / NET_FILE
     args = netconvert_args(files, net_file)
     log.info("running %s", " ".join(args))
     proc = subprocess.run(args, capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         raise RuntimeError(f"netconvert failed ({proc.returncode}):\n{proc.stderr}")
-    _apply_offset(net_file, "J2", layout.TLS_OFFSET_J2_S)
-    for tls_id, durations in layout.TLS_PHASE_DURATIONS_S.items():
+    for tls_id, offset_s in plan.tls_offsets_s.items():
+        _apply_offset(net_file, tls_id, offset_s)
+    for tls_id, durations in plan.tls_phase_durations_s.items():
         _apply_durations(net_file, tls_id, durations)
     return net_file
 

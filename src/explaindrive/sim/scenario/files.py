@@ -1,4 +1,10 @@
-"""Files of a scenario: the committed network and the demand generated per traffic level."""
+"""Files of a scenario: its network, the ego's route and the demand generated per traffic level.
+
+A scenario is the paper's road, a road of the family (:mod:`explaindrive.sim.scenario.params`)
+or a network of your own with a route through it (:mod:`explaindrive.sim.network`). The
+first two carry their flows and pedestrians in a :class:`~explaindrive.sim.scenario.layout.
+Layout`; an own network brings its background demand as route files.
+"""
 
 from __future__ import annotations
 
@@ -30,10 +36,15 @@ def _fmt(x: float) -> str:
     return f"{x:.6g}"
 
 
-def routes_xml(traffic_level: float) -> str:
-    """Vehicle demand at a traffic level: flows with Poisson arrivals and the ego route.
+def routes_xml(
+    traffic_level: float,
+    plan: layout.Layout | None = layout.PAPER_LAYOUT,
+    route_edges: tuple[str, ...] = layout.EGO_ROUTE_EDGES,
+) -> str:
+    """Vehicle demand at a traffic level: the vehicle types, the ego route and the plan's
+    flows with Poisson arrivals (none without a plan).
 
-    Flows scale with the level; level 1.0 puts 900 veh/h on the ego's main road.
+    Flows scale with the level; level 1.0 puts 900 veh/h on the paper's main road.
     Pedestrians are added by :class:`explaindrive.sim.pedestrians.PedestrianSource`.
     """
     level = layout.validate_traffic_level(traffic_level)
@@ -53,8 +64,10 @@ def routes_xml(traffic_level: float) -> str:
         '    <vType id="background" length="5" minGap="2.5" maxSpeed="20" accel="2.6" '
         'decel="4.5" sigma="0.5" carFollowModel="Krauss" color="0.8,0.8,0.2"/>'
     )
-    lines.append(f'    <route id="{EGO_ROUTE_ID}" edges="{" ".join(layout.EGO_ROUTE_EDGES)}"/>')
-    for flow in layout.FLOWS:
+    lines.append(f'    <route id="{EGO_ROUTE_ID}" edges="{" ".join(route_edges)}"/>')
+    for flow in plan.flows if plan is not None else ():
+        if flow.veh_per_hour <= 0:
+            continue
         rate = flow.veh_per_hour * level / 3600.0  # [veh/s]
         attrs = {
             "id": flow.id,
@@ -76,10 +89,72 @@ def routes_xml(traffic_level: float) -> str:
 
 @dataclass(frozen=True, slots=True)
 class ScenarioFiles:
-    """Locations of a scenario's network and of its generated files."""
+    """A scenario: its network, the ego's route, its demand, and where generated files go.
+
+    Attributes:
+        net_file: the SUMO network.
+        cache_dir: where demand files and warm-up states are kept.
+        route_edges: the ego's route.
+        plan: the family layout whose flows and pedestrians are the demand; ``None`` for an
+            own network, whose demand is ``demand_files``.
+        demand_files: background demand of an own network; SUMO scales it by the traffic
+            level (``--scale``).
+        trips: whether an own network's demand is trips generated over it at the traffic
+            level (:func:`explaindrive.sim.network.generated_trips`).
+        begin_s: simulation time at which the demand starts [s]; the warm-up runs from it.
+        name: how tables and logs name the scenario.
+    """
 
     net_file: Path
     cache_dir: Path
+    route_edges: tuple[str, ...] = layout.EGO_ROUTE_EDGES
+    plan: layout.Layout | None = layout.PAPER_LAYOUT
+    demand_files: tuple[Path, ...] = ()
+    trips: bool = False
+    begin_s: float = 0.0
+    name: str = "paper"
+
+    @property
+    def pedestrian_flows(self) -> tuple[layout.PedestrianFlow, ...]:
+        """The pedestrians the environment adds (an own network's come with its demand)."""
+        return self.plan.pedestrian_flows if self.plan is not None else ()
+
+    @property
+    def strategic_lane_changes(self) -> bool:
+        """Whether SUMO changes the ego's lanes to follow its route (own networks, which
+        may have several lanes; the family's roads have one)."""
+        return self.plan is None
+
+    def routes_files(self, traffic_level: float) -> tuple[Path, ...]:
+        """The route files SUMO loads at a traffic level: the generated one first."""
+        if self.trips:
+            from explaindrive.sim.network import generated_trips
+
+            return (self.routes_file(traffic_level),
+                    generated_trips(self.net_file, self.cache_dir, traffic_level))  # fmt: skip
+        return (self.routes_file(traffic_level), *self.demand_files)
+
+    def demand_args(self, traffic_level: float) -> list[str]:
+        """SUMO options for the demand at a traffic level, besides its route files."""
+        args = ["--begin", f"{self.begin_s:g}"] if self.begin_s else []
+        if self.demand_files:
+            args += ["--scale", f"{traffic_level:g}"]
+        return args
+
+    def state_reloads(self, traffic_level: float) -> bool:
+        """Whether a saved warm-up state reloads: not for a demand file scaled above 1, whose
+        copied vehicles SUMO 1.28 cannot restore (their routes are unknown on loading)."""
+        return not (self.demand_files and traffic_level > 1.0)
+
+    def demand_key(self, traffic_level: float) -> str:
+        """Names the demand at a traffic level (level and content hash) in cached files."""
+        key = self.routes_file(traffic_level).name.removesuffix(".rou.xml")
+        args = self.demand_args(traffic_level)
+        if not self.demand_files and not self.trips and not args:
+            return key
+        files = self.routes_files(traffic_level)[1:]
+        extra = "|".join([*(_digest(p) for p in files), *args])
+        return f"{key}_{hashlib.sha1(extra.encode()).hexdigest()[:10]}"
 
     def check(self) -> None:
         """Raise ``FileNotFoundError`` with a clear message if the network is missing."""
@@ -97,7 +172,7 @@ class ScenarioFiles:
 
     def routes_file(self, traffic_level: float) -> Path:
         """Demand file for a traffic level, written on first use (atomically)."""
-        text = routes_xml(traffic_level)
+        text = routes_xml(traffic_level, self.plan, self.route_edges)
         key = hashlib.sha1(text.encode()).hexdigest()[:10]
         path = self.cache_dir / "routes" / f"level{traffic_level:g}_{key}.rou.xml"
         if not path.exists():
@@ -111,6 +186,10 @@ class ScenarioFiles:
     def state_dir(self) -> Path:
         """Directory of cached warm-up states."""
         return self.cache_dir / "states" / self.net_digest
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha1(path.read_bytes()).hexdigest()[:10]
 
 
 def default_scenario(cache_dir: Path | None = None) -> ScenarioFiles:

@@ -22,6 +22,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from itertools import pairwise
 
+from explaindrive.sim.scenario.limits import (
+    MAX_TRAFFIC_LEVEL,
+    SATURATED_LEVEL,
+    SEED_LIMIT,
+    TRAFFIC_LEVELS,
+    validate_seed,
+    validate_traffic_level,
+)
+from explaindrive.sim.scenario.params import SIGNAL_FIXED_S, ScenarioParams
+
 KMH = 1.0 / 3.6  # [m/s per km/h]
 
 
@@ -81,41 +91,13 @@ class PedestrianFlow:
     arrival_pos_m: float  # [m] on ``to_edge``
 
 
-SPEED_50 = 50 * KMH  # [m/s]
-SPEED_30 = 30 * KMH  # [m/s]
-SIDE_SPEED = 50 * KMH  # [m/s]
 SIDEWALK_WIDTH_M = 2.0  # [m]
+SIDE_ROAD_M = 150.0  # [m] length of the side roads at J1 and J2
+FOOTPATH_M = 40.0  # [m] length of the footpaths to the zebra
+FOOTPATH_SPEED_MPS = 5 * KMH  # [m/s]
 
-NODES: tuple[Node, ...] = (
-    Node("W0", 0.0, 0.0, "dead_end"),
-    Node("J1", 400.0, 0.0, "traffic_light"),
-    Node("J1N", 400.0, 150.0, "dead_end"),
-    Node("J1S", 400.0, -150.0, "dead_end"),
-    Node("Z1", 600.0, 0.0, "priority"),
-    Node("PX", 800.0, 0.0, "priority"),
-    Node("PXN", 800.0, 40.0, "dead_end"),
-    Node("PXS", 800.0, -40.0, "dead_end"),
-    Node("Z2", 1000.0, 0.0, "priority"),
-    Node("J2", 1200.0, 0.0, "traffic_light"),
-    Node("J2N", 1200.0, 150.0, "dead_end"),
-    Node("J2S", 1200.0, -150.0, "dead_end"),
-    Node("E0", 1550.0, 0.0, "dead_end"),
-)
-
-ROADS: tuple[Road, ...] = (
-    Road("W0", "J1", SPEED_50),
-    Road("J1", "Z1", SPEED_50),
-    Road("Z1", "PX", SPEED_30),
-    Road("PX", "Z2", SPEED_30),
-    Road("Z2", "J2", SPEED_50),
-    Road("J2", "E0", SPEED_50),
-    Road("J1N", "J1", SIDE_SPEED),
-    Road("J1S", "J1", SIDE_SPEED),
-    Road("J2N", "J2", SIDE_SPEED),
-    Road("J2S", "J2", SIDE_SPEED),
-    Road("PXS", "PX", 5 * KMH, kind="footpath"),
-    Road("PXN", "PX", 5 * KMH, kind="footpath"),
-)
+EGO_ROUTE_NODES: tuple[str, ...] = ("W0", "J1", "Z1", "PX", "Z2", "J2", "E0")
+EGO_ROUTE_EDGES: tuple[str, ...] = tuple(f"{a}_{b}" for a, b in pairwise(EGO_ROUTE_NODES))
 
 # Crossings: (node, edges crossed). The zebra has priority over vehicles; the
 # crossing at J2 is controlled by J2's traffic light.
@@ -124,93 +106,110 @@ CROSSINGS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("J2", ("Z2_J2", "J2_Z2")),
 )
 
-EGO_ROUTE_NODES: tuple[str, ...] = ("W0", "J1", "Z1", "PX", "Z2", "J2", "E0")
-EGO_ROUTE_EDGES: tuple[str, ...] = tuple(f"{a}_{b}" for a, b in pairwise(EGO_ROUTE_NODES))
-
-# Main-road eastbound demand at traffic level 1.0: one vehicle every 4 s.
-MAIN_DEMAND_VEH_PER_HOUR = 900.0
-
-FLOWS: tuple[Flow, ...] = (
-    Flow("main_east", EGO_ROUTE_NODES, MAIN_DEMAND_VEH_PER_HOUR),
-    Flow("main_west", tuple(reversed(EGO_ROUTE_NODES)), 450.0),
-    Flow("j1_north_south", ("J1N", "J1", "J1S"), 150.0),
-    Flow("j1_south_north", ("J1S", "J1", "J1N"), 150.0),
-    Flow("j2_south_east", ("J2S", "J2", "E0"), 180.0),
-    Flow("j2_north_east", ("J2N", "J2", "E0"), 120.0),
-    Flow("j2_south_north", ("J2S", "J2", "J2N"), 60.0),
-    Flow("j2_north_south", ("J2N", "J2", "J2S"), 60.0),
-)
-
-PEDESTRIAN_FLOWS: tuple[PedestrianFlow, ...] = (
-    PedestrianFlow("zebra_northbound", "PXS_PX", "PX_PXN", 90.0, 5.0, 20.0),
-    PedestrianFlow("zebra_southbound", "PXN_PX", "PX_PXS", 90.0, 5.0, 20.0),
-    PedestrianFlow("j2_northbound", "Z2_J2", "J2_Z2", 120.0, 150.0, 50.0),
-    PedestrianFlow("j2_southbound", "J2_Z2", "Z2_J2", 120.0, 150.0, 50.0),
-)
-
-# Signal timing (static programs, seconds). netconvert builds the phases; their
-# durations are then set here: the main road gets most of the 60 s cycle so that
-# it carries its demand up to about traffic level 1.5.
+# Signal timing (static programs, seconds). netconvert builds the phases with these
+# settings; their durations and offsets then come from the scenario's parameters.
 TLS_CYCLE_S = 60
 TLS_YELLOW_S = 3
 TLS_ALL_RED_S = 2  # [s] clearance between conflicting streams
-TLS_OFFSET_J2_S = 25  # [s] offset of J2 against J1 (a partial green wave)
-TLS_PHASE_DURATIONS_S: dict[str, tuple[int, ...]] = {
-    "J1": (37, 3, 2, 13, 3, 2),  # main green, yellow, all red, side green, yellow, all red
-    # main green, yellow, all red, side + pedestrians, side only, yellow, all red
-    "J2": (34, 3, 2, 13, 3, 3, 2),
-}
 
 
-def traffic_level_demand(level: float) -> float:
-    """Main-road eastbound demand [veh/h] at a traffic level (1.0 = 900 veh/h).
+@dataclass(frozen=True, slots=True)
+class Layout:
+    """A scenario of the family as nodes, roads, flows and signal timings."""
 
-    Raises:
-        ValueError: if ``level`` is not a positive finite number.
-    """
-    validate_traffic_level(level)
-    return MAIN_DEMAND_VEH_PER_HOUR * level
-
-
-TRAFFIC_LEVELS: tuple[float, ...] = (0.5, 0.75, 1.0, 1.25, 1.5)
-"""The paper's five traffic levels (1.0 = 900 veh/h on the main road)."""
-MAX_TRAFFIC_LEVEL = 1.75
-"""The busiest level the scenario accepts: at 1.75 the ego entered the road in every one of
-seeds 0-49; at 2.0 the first road stayed blocked in 5 of seeds 0-29."""
-SEED_LIMIT = 2**31
-"""SUMO's seeds are integers in [0, SEED_LIMIT)."""
+    nodes: tuple[Node, ...]
+    roads: tuple[Road, ...]
+    flows: tuple[Flow, ...]
+    pedestrian_flows: tuple[PedestrianFlow, ...]
+    tls_phase_durations_s: dict[str, tuple[int, ...]]
+    tls_offsets_s: dict[str, int]
 
 
-def validate_traffic_level(level: float) -> float:
-    """Return ``level`` as a float if it is in (0, :data:`MAX_TRAFFIC_LEVEL`].
+def make_layout(params: ScenarioParams) -> Layout:
+    """The nodes, roads, flows and signal timings of a scenario of the family."""
+    blocks = (params.approach_m, params.j1_to_zone_m, params.zone_to_crossing_m,
+              params.crossing_to_zone_end_m, params.zone_end_to_j2_m, params.exit_m)  # fmt: skip
+    x = dict(zip(EGO_ROUTE_NODES, _cumulative(blocks), strict=True))
+    main, zone, side = (params.limit_kmh * KMH, params.zone_limit_kmh * KMH,
+                        params.side_limit_kmh * KMH)  # fmt: skip
+    types = {"W0": "dead_end", "J1": "traffic_light", "J2": "traffic_light", "E0": "dead_end"}
+    nodes = [Node(n, x[n], 0.0, types.get(n, "priority")) for n in EGO_ROUTE_NODES]
+    for n, y in (("N", SIDE_ROAD_M), ("S", -SIDE_ROAD_M)):
+        nodes.append(Node(f"J1{n}", x["J1"], y, "dead_end"))
+        nodes.append(Node(f"PX{n}", x["PX"], FOOTPATH_M if y > 0 else -FOOTPATH_M, "dead_end"))
+        nodes.append(Node(f"J2{n}", x["J2"], y, "dead_end"))
+    order = ("W0", "J1", "J1N", "J1S", "Z1", "PX", "PXN", "PXS", "Z2", "J2", "J2N", "J2S", "E0")
+    by_id = {n.id: n for n in nodes}
+    limits = (main, main, zone, zone, main, main)
+    roads = [Road(a, b, v) for (a, b), v in zip(pairwise(EGO_ROUTE_NODES), limits, strict=True)]
+    roads += [Road(f"{j}{n}", j, side) for j in ("J1", "J2") for n in ("N", "S")]
+    roads += [Road(f"PX{n}", "PX", FOOTPATH_SPEED_MPS, kind="footpath") for n in ("S", "N")]
+    d = params.demand
+    flows = (
+        Flow("main_east", EGO_ROUTE_NODES, d.main_east),
+        Flow("main_west", tuple(reversed(EGO_ROUTE_NODES)), d.main_west),
+        Flow("j1_north_south", ("J1N", "J1", "J1S"), d.j1_cross),
+        Flow("j1_south_north", ("J1S", "J1", "J1N"), d.j1_cross),
+        Flow("j2_south_east", ("J2S", "J2", "E0"), d.j2_turn_south),
+        Flow("j2_north_east", ("J2N", "J2", "E0"), d.j2_turn_north),
+        Flow("j2_south_north", ("J2S", "J2", "J2N"), d.j2_cross),
+        Flow("j2_north_south", ("J2N", "J2", "J2S"), d.j2_cross),
+    )
+    zebra, j2 = params.zebra_peds_per_hour, params.j2_peds_per_hour
+    # pedestrians at J2 walk along the block Z2-J2 from 150 m (at most 3/4 of it) to 50 m
+    # (at most half of it) along the edge they start and end on
+    j2_depart = min(150.0, 0.75 * params.zone_end_to_j2_m)
+    j2_arrival = min(50.0, params.zone_end_to_j2_m / 2)
+    peds = (
+        PedestrianFlow("zebra_northbound", "PXS_PX", "PX_PXN", zebra, 5.0, 20.0),
+        PedestrianFlow("zebra_southbound", "PXN_PX", "PX_PXS", zebra, 5.0, 20.0),
+        PedestrianFlow("j2_northbound", "Z2_J2", "J2_Z2", j2, j2_depart, j2_arrival),
+        PedestrianFlow("j2_southbound", "J2_Z2", "Z2_J2", j2, j2_depart, j2_arrival),
+    )
+    return Layout(
+        nodes=tuple(by_id[n] for n in order),
+        roads=tuple(roads),
+        flows=flows,
+        pedestrian_flows=tuple(p for p in peds if p.persons_per_hour > 0),
+        tls_phase_durations_s={
+            "J1": params.j1.durations(SIGNAL_FIXED_S["J1"]),
+            "J2": params.j2.durations(SIGNAL_FIXED_S["J2"]),
+        },
+        tls_offsets_s={"J1": params.j1.offset_s, "J2": params.j2.offset_s},
+    )
 
-    Raises:
-        ValueError: naming the range, otherwise.
-    """
-    import math
 
-    if isinstance(level, bool) or not isinstance(level, int | float) or not math.isfinite(level):
-        raise ValueError(f"traffic level must be a finite number > 0, got {level!r}")
-    if level <= 0:
-        raise ValueError(f"traffic level must be > 0, got {level:g}")
-    if level > MAX_TRAFFIC_LEVEL:
-        raise ValueError(
-            f"traffic level must be at most {MAX_TRAFFIC_LEVEL:g}, got {level:g}: on a busier "
-            "road the ego cannot enter"
-        )
-    return float(level)
+def _cumulative(blocks: tuple[float, ...]) -> list[float]:
+    xs = [0.0]
+    for b in blocks:
+        xs.append(xs[-1] + b)
+    return xs
 
 
-def validate_seed(seed: object) -> int:
-    """Return ``seed`` as an int if it is an integer in [0, :data:`SEED_LIMIT`).
+PAPER_LAYOUT = make_layout(ScenarioParams())
+"""The paper's road."""
+NODES = PAPER_LAYOUT.nodes
+ROADS = PAPER_LAYOUT.roads
+FLOWS = PAPER_LAYOUT.flows
+PEDESTRIAN_FLOWS = PAPER_LAYOUT.pedestrian_flows
+TLS_PHASE_DURATIONS_S = PAPER_LAYOUT.tls_phase_durations_s
 
-    Raises:
-        ValueError: otherwise.
-    """
-    import numbers
-
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
-        raise ValueError(f"seed must be an integer in [0, 2**31), got {seed!r}")
-    if not 0 <= int(seed) < SEED_LIMIT:
-        raise ValueError(f"seed must be an integer in [0, 2**31), got {seed!r}")
-    return int(seed)
+__all__ = [
+    "CROSSINGS",
+    "EGO_ROUTE_EDGES",
+    "EGO_ROUTE_NODES",
+    "FLOWS",
+    "KMH",
+    "MAX_TRAFFIC_LEVEL",
+    "NODES",
+    "PAPER_LAYOUT",
+    "PEDESTRIAN_FLOWS",
+    "ROADS",
+    "SATURATED_LEVEL",
+    "SEED_LIMIT",
+    "TRAFFIC_LEVELS",
+    "Layout",
+    "make_layout",
+    "validate_seed",
+    "validate_traffic_level",
+]

@@ -1,0 +1,182 @@
+"""A SUMO network of your own as a scenario: a route through it and its background demand.
+
+The ego's route is SUMO's shortest path for passenger cars between two edges (sumolib);
+its stop lines, crossings and speed limits are then read along that route
+(:mod:`explaindrive.sim.route`). The background demand is a route file of your own,
+starting wherever its first departure is (e.g. 25200 s, 7:00), which the traffic level
+scales (SUMO's ``--scale``; 1.0 is the file as given), or else trips that SUMO's
+``randomTrips.py`` generates over the whole network, :data:`TRIPS_PER_HOUR_PER_KM` times
+the traffic level.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import os
+import subprocess
+import sys
+import tempfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from explaindrive.sim.scenario.files import FLOW_END_S, ScenarioFiles
+from explaindrive.sim.sumo_home import sumo_home
+
+log = logging.getLogger(__name__)
+
+TRIPS_PER_HOUR_PER_KM = 60.0
+"""[veh/h per km of lane] generated background trips at traffic level 1.0."""
+TRIPS_SEED = 42
+"""Seed of the generated trips (the episode seed varies the simulation itself)."""
+_DEPART_TAGS = ("vehicle", "trip", "flow", "person", "personFlow")
+
+
+class NetworkError(ValueError):
+    """A network, route or demand file that cannot be used; the message names why."""
+
+
+def check_network_file(net_file: Path) -> None:
+    """Raise :class:`NetworkError` unless ``net_file`` is a SUMO network file."""
+    if not net_file.is_file():
+        raise NetworkError(f"network file not found: {net_file}")
+    try:
+        for _event, elem in ET.iterparse(net_file, events=("start",)):
+            if elem.tag != "net":
+                raise NetworkError(
+                    f"{net_file} is not a SUMO network (its root element is <{elem.tag}>, "
+                    "not <net>)"
+                )
+            return
+    except ET.ParseError as exc:
+        raise NetworkError(f"{net_file} is not a SUMO network (not XML: {exc})") from None
+
+
+def parse_route(text: str) -> tuple[str, str]:
+    """``FROM_EDGE,TO_EDGE`` as a pair of edge ids.
+
+    Raises:
+        NetworkError: unless the text holds exactly two non-empty edge ids.
+    """
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) != 2 or not all(parts):
+        raise NetworkError(f"route {text!r} must look like FROM_EDGE,TO_EDGE")
+    return parts[0], parts[1]
+
+
+def route_edges(net_file: Path, from_edge: str, to_edge: str) -> tuple[str, ...]:
+    """SUMO's shortest route for passenger cars from ``from_edge`` to ``to_edge``.
+
+    Raises:
+        NetworkError: if an edge is missing, does not allow cars, or no path joins them.
+    """
+    import sumolib
+
+    check_network_file(net_file)
+    net = sumolib.net.readNet(str(net_file))
+    for edge_id in (from_edge, to_edge):
+        if not net.hasEdge(edge_id):
+            raise NetworkError(f"edge {edge_id!r} not found in {net_file}")
+        if not net.getEdge(edge_id).allows("passenger"):
+            raise NetworkError(f"edge {edge_id!r} in {net_file} does not allow cars")
+    path, _cost = net.getShortestPath(
+        net.getEdge(from_edge), net.getEdge(to_edge), vClass="passenger"
+    )
+    if not path:
+        raise NetworkError(f"no path for cars from edge {from_edge!r} to {to_edge!r} in {net_file}")
+    return tuple(e.getID() for e in path)
+
+
+def demand_begin_s(demand_file: Path) -> float:
+    """The first departure [s] in a route file (0 if it has none).
+
+    Raises:
+        NetworkError: if the file is missing or not XML.
+    """
+    if not demand_file.is_file():
+        raise NetworkError(f"demand file not found: {demand_file}")
+    first = float("inf")
+    try:
+        for _event, elem in ET.iterparse(demand_file, events=("start",)):
+            depart = elem.get("begin" if elem.tag.endswith("Flow") or elem.tag == "flow"
+                              else "depart")  # fmt: skip
+            if elem.tag in _DEPART_TAGS and depart is not None:
+                try:
+                    first = min(first, float(depart))
+                except ValueError:
+                    continue  # "triggered" and the like
+    except ET.ParseError as exc:
+        raise NetworkError(f"demand file {demand_file} is not XML: {exc}") from None
+    return 0.0 if first == float("inf") else first
+
+
+def generated_trips(net_file: Path, cache_dir: Path, traffic_level: float = 1.0) -> Path:
+    """Background trips over the whole network at a traffic level, made once per network and
+    level with ``randomTrips.py`` and cached.
+
+    Raises:
+        NetworkError: if randomTrips fails (e.g. no two edges are connected).
+    """
+    digest = hashlib.sha1(net_file.read_bytes()).hexdigest()[:10]
+    density = TRIPS_PER_HOUR_PER_KM * traffic_level  # [veh/h per km of lane]
+    path = cache_dir / "trips" / f"{digest}_{density:g}.rou.xml"
+    if path.exists():
+        return path
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=path.parent))
+    script = sumo_home() / "tools" / "randomTrips.py"
+    args = [
+        sys.executable, str(script), "-n", str(net_file), "-o", str(tmp / "trips.xml"),
+        "-r", str(tmp / "routes.rou.xml"), "--begin", "0", "--end", str(FLOW_END_S),
+        "--insertion-density", f"{density:g}", "--seed", str(TRIPS_SEED),
+        "--vehicle-class", "passenger", "--fringe-factor", "5", "--min-distance", "100",
+        "--prefix", "bg", "--validate",
+        "--trip-attributes", 'departLane="best" departSpeed="max"',
+    ]  # fmt: skip
+    proc = subprocess.run(args, capture_output=True, text=True, check=False, cwd=tmp)
+    routes = tmp / "routes.rou.xml"
+    if proc.returncode != 0 or not routes.is_file():
+        detail = (proc.stderr or proc.stdout).strip().splitlines()[-1:] or ["no output"]
+        raise NetworkError(f"randomTrips.py could not make trips for {net_file}: {detail[0]}")
+    os.replace(routes, path)
+    for leftover in tmp.iterdir():
+        leftover.unlink()
+    tmp.rmdir()
+    return path
+
+
+def own_network(
+    net_file: Path,
+    route: tuple[str, str],
+    cache_dir: Path,
+    demand_file: Path | None = None,
+) -> ScenarioFiles:
+    """A scenario on a network of your own: the route between two edges, the given demand
+    (or trips generated over the network), starting where the demand starts.
+
+    Raises:
+        NetworkError: naming what cannot be used.
+    """
+    from explaindrive.sim.route import load_route_geometry
+
+    edges = route_edges(net_file, *route)
+    try:
+        load_route_geometry(net_file, edges)
+    except (ValueError, KeyError) as exc:
+        raise NetworkError(f"route {route[0]} -> {route[1]} cannot be driven: {exc}") from None
+    demand: tuple[Path, ...]
+    if demand_file is not None:
+        demand, begin = (demand_file,), demand_begin_s(demand_file)
+    else:
+        generated_trips(net_file, cache_dir)  # made now: a network without trips fails here
+        demand, begin = (), 0.0
+    return ScenarioFiles(
+        net_file=net_file,
+        cache_dir=cache_dir,
+        route_edges=edges,
+        plan=None,
+        demand_files=demand,
+        trips=demand_file is None,
+        begin_s=begin,
+        name=f"{net_file.name}:{route[0]}->{route[1]}",
+    )

@@ -1,0 +1,155 @@
+"""Parameters of the urban scenario family: the one place that fixes their defaults and ranges.
+
+The defaults are the paper's road (:mod:`explaindrive.sim.scenario.layout` builds it from
+``ScenarioParams()``). Every field has a range; :mod:`explaindrive.sim.scenario.generator`
+draws scenarios uniformly within the ranges written here. Keys are given dotted on the
+command line (``--set j1.cycle_s=90``) and nested in ``scenario.yaml``.
+
+The road, west to east (block lengths in metres)::
+
+    W0 --approach_m-- J1 --j1_to_zone_m-- Z1 --zone_to_crossing_m-- PX
+       --crossing_to_zone_end_m-- Z2 --zone_end_to_j2_m-- J2 --exit_m-- E0
+
+``Z1``..``Z2`` is the low-limit zone around the zebra ``PX``.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Self
+
+from pydantic import Field, model_validator
+
+from explaindrive.config import ConfigModel, StrictModel
+
+MIN_LIMIT_KMH = 20.0  # [km/h]
+MAX_LIMIT_KMH = 70.0  # [km/h] below the observation's speed bound (20 m/s = 72 km/h)
+LimitKmh = Annotated[float, Field(ge=MIN_LIMIT_KMH, le=MAX_LIMIT_KMH)]
+Block = Annotated[float, Field(ge=60.0, le=600.0)]
+"""A block length [m]: long enough to stop from 70 km/h (about 60 m at 3 m/s^2) before
+the next junction."""
+PedRate = Annotated[float, Field(ge=0.0, le=400.0)]
+"""Pedestrians per hour in one direction (0: none)."""
+
+SIGNAL_FIXED_S = {"J1": 0, "J2": 3}
+"""[s] phases a light has besides greens, yellows and all-reds: J2 keeps its side road green
+3 s after its pedestrians' green ends (the crossing clears)."""
+MIN_SIDE_GREEN_S = 5  # [s]
+
+
+class SignalParams(StrictModel):
+    """A static two-stream signal program: main road, then side road (and pedestrians)."""
+
+    cycle_s: int = Field(ge=40, le=120)
+    """Cycle length [s]."""
+    main_green_s: int = Field(ge=10, le=100)
+    """Green of the main road [s] (the split); the side road gets the rest of the cycle."""
+    yellow_s: int = Field(default=3, ge=3, le=5)
+    """Yellow after each green [s]."""
+    all_red_s: int = Field(default=2, ge=1, le=3)
+    """All-red clearance after each yellow [s]."""
+    offset_s: int = Field(default=0, ge=0, le=119)
+    """Start of the program within the cycle [s] (a green wave between the lights)."""
+
+    def side_green_s(self, fixed_s: int) -> int:
+        """Green of the side road [s] given the light's other fixed phases."""
+        return self.cycle_s - self.main_green_s - 2 * (self.yellow_s + self.all_red_s) - fixed_s
+
+    def durations(self, fixed_s: int) -> tuple[int, ...]:
+        """Phase durations in netconvert's order: main green, yellow, all red, side green,
+        (side-only ``fixed_s``,) yellow, all red."""
+        side = self.side_green_s(fixed_s)
+        extra = (fixed_s,) if fixed_s else ()
+        y, r = self.yellow_s, self.all_red_s
+        return (self.main_green_s, y, r, side, *extra, y, r)
+
+
+class DemandParams(StrictModel):
+    """Vehicle flows at traffic level 1.0 [veh/h]; they scale with the level."""
+
+    main_east: float = Field(default=900.0, ge=300.0, le=1200.0)
+    """Eastbound on the main road, the ego's direction."""
+    main_west: float = Field(default=450.0, ge=0.0, le=900.0)
+    """Westbound on the main road."""
+    j1_cross: float = Field(default=150.0, ge=0.0, le=300.0)
+    """Across the main road at J1, each direction."""
+    j2_turn_south: float = Field(default=180.0, ge=0.0, le=300.0)
+    """From J2's south arm turning east ahead of the ego."""
+    j2_turn_north: float = Field(default=120.0, ge=0.0, le=300.0)
+    """From J2's north arm turning east ahead of the ego."""
+    j2_cross: float = Field(default=60.0, ge=0.0, le=200.0)
+    """Across the main road at J2, each direction."""
+
+
+class ScenarioParams(ConfigModel):
+    """A scenario of the family; the defaults are the paper's road."""
+
+    config_name = "scenario"
+
+    approach_m: Block = 400.0
+    """From the start W0 to the first light J1 [m]."""
+    j1_to_zone_m: Block = 200.0
+    """From J1 to the start Z1 of the low-limit zone [m]."""
+    zone_to_crossing_m: Block = 200.0
+    """From Z1 to the zebra crossing PX [m]."""
+    crossing_to_zone_end_m: Block = 200.0
+    """From PX to the end Z2 of the zone [m]."""
+    zone_end_to_j2_m: Block = 200.0
+    """From Z2 to the second light J2 [m]."""
+    exit_m: Block = 350.0
+    """From J2 to the end E0 [m]."""
+    limit_kmh: LimitKmh = 50.0
+    """Speed limit of the main road outside the zone [km/h]."""
+    zone_limit_kmh: LimitKmh = 30.0
+    """Speed limit in the zone around the zebra [km/h]."""
+    side_limit_kmh: LimitKmh = 50.0
+    """Speed limit of the side roads [km/h]."""
+    j1: SignalParams = SignalParams(cycle_s=60, main_green_s=37)
+    """Signal program of J1."""
+    j2: SignalParams = SignalParams(cycle_s=60, main_green_s=34, offset_s=25)
+    """Signal program of J2 (its offset is against J1)."""
+    zebra_peds_per_hour: PedRate = 90.0
+    """Pedestrians crossing at the zebra PX per hour, each direction."""
+    j2_peds_per_hour: PedRate = 120.0
+    """Pedestrians crossing J2's west arm per hour, each direction."""
+    demand: DemandParams = DemandParams()
+    """Vehicle flows at traffic level 1.0."""
+
+    @model_validator(mode="after")
+    def _check_signals(self) -> Self:
+        for name in ("j1", "j2"):
+            signal: SignalParams = getattr(self, name)
+            side = signal.side_green_s(SIGNAL_FIXED_S[name.upper()])
+            if side < MIN_SIDE_GREEN_S:
+                raise ValueError(
+                    f"{name}: the side road's green would be {side} s (cycle_s minus "
+                    f"main_green_s and the yellow/all-red/clearance phases); at least "
+                    f"{MIN_SIDE_GREEN_S} s is needed"
+                )
+            if signal.offset_s >= signal.cycle_s:
+                raise ValueError(f"{name}: offset_s must be below cycle_s ({signal.cycle_s})")
+        return self
+
+    @classmethod
+    def from_settings(cls, settings: list[str], base: ScenarioParams | None = None) -> Self:
+        """Parameters from ``key=value`` texts with dotted keys (``j1.cycle_s=90``) over
+        ``base`` (default: the paper's road).
+
+        Raises:
+            ConfigError: on a malformed setting, an unknown key or a value out of range.
+        """
+        from explaindrive.config import ConfigError, read_yaml
+
+        data: dict[str, Any] = (base or cls()).to_dict()
+        for item in settings:
+            key, sep, text = item.partition("=")
+            if not sep or not key.strip():
+                raise ConfigError(f"scenario setting {item!r} must look like KEY=VALUE")
+            *parents, leaf = key.strip().split(".")
+            node = data
+            for part in parents:
+                child = node.get(part)
+                if not isinstance(child, dict):
+                    raise ConfigError(f"unknown scenario key {key.strip()!r}")
+                node = child
+            node[leaf] = read_yaml(text)
+        return cls.from_dict(data)

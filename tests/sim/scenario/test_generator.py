@@ -1,0 +1,82 @@
+"""The seeded scenario generator: reproducible, inside its ranges, held-out seeds apart."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.sim.route import load_route_geometry
+from explaindrive.sim.scenario.directory import (
+    cached_scenario_dir,
+    load_scenario_dir,
+    read_params,
+    write_scenario_dir,
+)
+from explaindrive.sim.scenario.generator import (
+    RANGES,
+    TRAIN_SEED_START,
+    extreme_params,
+    random_params,
+    training_seed,
+)
+
+
+def test_a_seed_gives_one_scenario_and_seeds_differ() -> None:
+    assert random_params(5) == random_params(5)
+    assert len({random_params(s).to_json() for s in range(50)}) == 50
+
+
+def test_draws_stay_in_their_ranges() -> None:
+    for seed in range(50):
+        p = random_params(seed)
+        lo, hi, _ = RANGES["approach_m"]
+        assert lo <= p.approach_m <= hi and p.approach_m % 10 == 0
+        assert p.zone_limit_kmh <= p.limit_kmh
+        assert 50 <= p.j1.cycle_s <= 100 and p.j1.offset_s == 0 and p.j2.offset_s < p.j2.cycle_s
+
+
+def test_the_ends_of_the_ranges() -> None:
+    low, high = extreme_params("low"), extreme_params("high")
+    assert (low.approach_m, low.limit_kmh, low.zone_limit_kmh, low.j1.cycle_s) == (150, 30, 20, 50)
+    assert (high.exit_m, high.limit_kmh, high.zone_limit_kmh, high.j2.cycle_s) == (500, 70, 40, 100)
+    # low J1: 50 s cycle, yellow 3, all-red 1: green 50 - 8 = 42, half to the main road
+    assert (low.j1.main_green_s, low.j1.side_green_s(0)) == (21, 21)
+    # high J2: 100 s, yellow 4, all-red 2, 3 s clearance: green 100 - 15 = 85, 3/4 -> 64
+    assert (high.j2.main_green_s, high.j2.side_green_s(3), high.j2.offset_s) == (64, 21, 99)
+    assert (low.zebra_peds_per_hour, high.j2_peds_per_hour) == (0, 200)
+
+
+def test_training_draws_are_never_held_out() -> None:
+    assert training_seed(0) == TRAIN_SEED_START
+    assert training_seed(2**31 - 1) >= TRAIN_SEED_START
+
+
+def test_a_scenario_directory_round_trips(tmp_path: Path) -> None:
+    params = random_params(3)
+    write_scenario_dir(tmp_path, params, "three", seed=3)
+    assert read_params(tmp_path) == ("three", params)
+    files = load_scenario_dir(tmp_path, tmp_path / "cache")
+    geometry = load_route_geometry(files.net_file, files.route_edges)
+    # stop line of J1: the approach block minus the junction's half width (7.2 m here)
+    assert geometry.lights[0].stop_line_m == pytest.approx(params.approach_m - 7.2, abs=0.5)
+    assert [c.signalized for c in geometry.crossings] == [False, True]
+
+
+@pytest.mark.parametrize("end", ["low", "high"])
+def test_scenarios_at_the_ends_of_the_ranges_drive(end: str, tmp_path: Path) -> None:
+    directory = cached_scenario_dir(extreme_params(end), end, tmp_path)  # type: ignore[arg-type]
+    env = UrbanDriveEnv(scenario=str(directory), max_steps=40, warmup_s=60, traffic_level=1.75)
+    try:
+        obs, info = env.reset(seed=1)
+        assert info["scenario"] == end
+        limit = (30 if end == "low" else 70) / 3.6
+        assert obs[2] == pytest.approx(limit, abs=0.01)
+        for _ in range(40):
+            _obs, _r, terminated, truncated, _info = env.step(4)
+            if terminated or truncated:
+                break
+        assert truncated or terminated
+    finally:
+        env.close()
