@@ -13,6 +13,7 @@ on an error writes the same and exits with status 1.
 
 from __future__ import annotations
 
+import dataclasses
 import queue
 import sys
 import threading
@@ -268,7 +269,7 @@ def _run(
         discard_ride(staging)
         _exit_unchanged(stop.signum, out)
     final = commit_ride(staging, out)
-    return RideOutputs(final.events, final.summary, final.figure, outputs.interrupted)
+    return dataclasses.replace(final, interrupted=outputs.interrupted)
 
 
 def _passenger_input(voice: bool) -> queue.Queue[str]:
