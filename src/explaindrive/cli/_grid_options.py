@@ -13,6 +13,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from explaindrive.cli._errors import error_line
+from explaindrive.limits import MAX_STEPS, MAX_WORKERS
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 if TYPE_CHECKING:
@@ -34,7 +35,8 @@ ShieldOption = Annotated[
     typer.Option("--shield/--no-shield", help="Agents act through the safety shield."),
 ]
 WorkersOption = Annotated[
-    int | None, typer.Option("--workers", min=1, help="Processes (default: one per CPU).")
+    int | None,
+    typer.Option("--workers", min=1, max=MAX_WORKERS, help="Processes (default: one per CPU)."),
 ]
 RayOption = Annotated[bool, typer.Option("--ray", help="Run the episodes on a local Ray.")]
 RayAddressOption = Annotated[
@@ -45,7 +47,7 @@ JsonOption = Annotated[
     Path | None, typer.Option("--json", help="Write every episode and the aggregates here.")
 ]
 MaxStepsOption = Annotated[
-    int, typer.Option("--max-steps", min=1, help="Step limit per episode [s].")
+    int, typer.Option("--max-steps", min=1, max=MAX_STEPS, help="Step limit per episode [s].")
 ]
 
 

@@ -11,6 +11,7 @@ from rich.console import Console
 from explaindrive.cli import _grid_options as grid
 from explaindrive.cli._errors import error_line
 from explaindrive.cli._grid_options import err_console
+from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.evaluation.paper import PAPER_SEEDS
 
 if TYPE_CHECKING:
@@ -67,6 +68,7 @@ def evaluate_command(
         plan_run,
     )
 
+    refuse_bad_outputs(files=((json_file, "--json"),), folders=((figures, "--figures"),))
     try:
         spec = parse_policy(
             policy, fast_path=fast_policy, comfort_path=comfort_policy, shield=shield

@@ -29,6 +29,7 @@ from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
 from explaindrive.cli._signals import exit_status, handle_signals, signal_label
 from explaindrive.language.config import LanguageConfig
+from explaindrive.limits import MAX_SEED
 from explaindrive.redact import redact
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.runner import (
@@ -85,7 +86,7 @@ BackendOption = Annotated[
 CooldownOption = Annotated[float, typer.Option("--cooldown", help="Explanation cool-down [s].")]
 # The simulation
 TrafficOption = Annotated[float, typer.Option("--traffic", help="Traffic level (1.0 = 900 veh/h).")]
-SeedOption = Annotated[int, typer.Option("--seed", help="Simulation seed.")]
+SeedOption = Annotated[int, typer.Option("--seed", min=0, max=MAX_SEED, help="Simulation seed.")]
 MaxStepsOption = Annotated[int, typer.Option("--max-steps", help="Longest ride [s].")]
 GuiOption = Annotated[bool, typer.Option("--gui", help="Show the ride in sumo-gui.")]
 RealtimeOption = Annotated[bool, typer.Option("--realtime", help="One step per second.")]

@@ -8,6 +8,7 @@ import typer
 from rich.console import Console
 
 from explaindrive.cli._errors import error_line
+from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.sim.scenario.files import package_data_dir
 
 scenario_app = typer.Typer(help="Build or draw the urban SUMO scenario.", no_args_is_help=True)
@@ -20,6 +21,7 @@ def build(
     """Write the plain XML and run netconvert to produce urban.net.xml."""
     from explaindrive.sim.scenario.build import build_network
 
+    refuse_bad_outputs(folders=((out, "--out"),))
     net = build_network(out or package_data_dir())
     Console().print(f"network written to {net}")
 
@@ -32,6 +34,7 @@ def plot(
     """Draw the network to a PNG."""
     from explaindrive.sim.scenario.plot import plot_network
 
+    refuse_bad_outputs(files=((out, "--out"),))
     net_file = net or package_data_dir() / "urban.net.xml"
     if not net_file.is_file():
         Console().print(error_line(f"network file not found: {net_file}"))
