@@ -19,7 +19,7 @@ from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 if TYPE_CHECKING:
     from explaindrive.evaluation.runner import Progress as EpisodeProgress
 
-err_console = Console(stderr=True)
+err_console = Console(stderr=True, soft_wrap=True)  # an error line never wraps
 
 DEFAULT_TRAFFIC = ",".join(f"{x:g}" for x in TRAFFIC_LEVELS)
 
@@ -52,15 +52,18 @@ MaxStepsOption = Annotated[
 
 
 def check_ray_target(ray: bool, ray_address: str | None) -> str | None:
-    """The error message when both ``--ray`` and ``--ray-address`` are given, or when either
-    is given without Ray installed; else ``None``."""
+    """The error message when both ``--ray`` and ``--ray-address`` are given, when either
+    is given without Ray installed, or when nothing answers at ``--ray-address`` (within
+    :data:`~explaindrive.limits.RAY_CONNECT_TIMEOUT_S`); else ``None``."""
     if ray and ray_address:
         return "give --ray or --ray-address, not both"
     if ray or ray_address:
-        from explaindrive.agent.ray_pool import RAY_MISSING, ray_installed
+        from explaindrive.agent.ray_pool import RAY_MISSING, ray_installed, unreachable_ray_address
 
         if not ray_installed():
             return RAY_MISSING
+        if ray_address:
+            return unreachable_ray_address(ray_address)
     return None
 
 
