@@ -146,7 +146,7 @@ TrafficLevel = Annotated[float, BeforeValidator(validate_traffic_level)]
 Seed = Annotated[int, BeforeValidator(validate_seed)]
 """A simulation seed in [0, :data:`~explaindrive.sim.scenario.layout.SEED_LIMIT`)."""
 
-StepLimit = Annotated[int, Field(ge=1, le=MAX_STEPS)]
+StepLimit = Annotated[int, Field(gt=0, le=MAX_STEPS)]
 """The step limit of an episode or a ride, in [1, :data:`~explaindrive.limits.MAX_STEPS`]."""
 
 

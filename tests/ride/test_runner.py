@@ -118,22 +118,23 @@ def test_a_ride_that_fails_writes_its_steps_then_raises(tmp_path: Path) -> None:
 def test_prepare_out_dir_checks_the_folder_and_touches_nothing_in_it(tmp_path: Path) -> None:
     new = tmp_path / "a" / "b"
     assert prepare_out_dir(new) == tmp_path / "a" / ".b.new"
-    assert (tmp_path / "a" / ".b.new").is_dir() and not new.exists()
+    assert list(tmp_path.iterdir()) == []  # nothing is made before the ride
     (tmp_path / "file").write_text("x")
     with pytest.raises(OutputDirError, match="is a file, not a folder"):
         prepare_out_dir(tmp_path / "file")
-    with pytest.raises(OutputDirError, match="cannot be written: Not a directory"):
+    with pytest.raises(OutputDirError, match=r"file/ride: .*file is a file, not a folder"):
         prepare_out_dir(tmp_path / "file" / "ride")
-    new.mkdir()
+    new.mkdir(parents=True)
     for name in ("events.jsonl", "summary.json", "ride.png", "notes.txt"):
         (new / name).write_text("old ride")
     with pytest.raises(
         OutputDirError, match=r"not empty \(events.jsonl, notes.txt, ride.png, \.\.\.\).*--force"
     ):
         prepare_out_dir(new)
+    staging_dir(new).mkdir()
     (staging_dir(new) / "events.jsonl").write_text("a ride killed outright")
     staging = prepare_out_dir(new, force=True)
-    assert list(staging.iterdir()) == []  # a fresh staging folder
+    assert not staging.exists()  # removed; run_ride makes it afresh
     assert sorted(p.read_text() for p in new.iterdir()) == ["old ride"] * 4  # all kept
 
 
@@ -156,6 +157,7 @@ def test_a_discarded_ride_leaves_the_previous_one_as_it_was(tmp_path: Path) -> N
     out.mkdir()
     (out / "summary.json").write_text("old ride")
     staging = prepare_out_dir(out, force=True)
+    staging.mkdir()
     (staging / "events.jsonl").write_text("")
     discard_ride(staging)
     assert [p.name for p in tmp_path.iterdir()] == ["ride"]

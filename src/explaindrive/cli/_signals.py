@@ -19,6 +19,16 @@ HANDLED_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 Handler = Callable[[int, FrameType | None], None]
 
 
+class SignalInterrupt(KeyboardInterrupt):
+    """The ``KeyboardInterrupt`` the program's handler raises for a signal.
+
+    A subclass on purpose: when a plain ``KeyboardInterrupt`` passes through Python code
+    that C code runs (as some extensions do while they are imported), CPython notes it and
+    ends the process by SIGINT at exit, even if the exception was caught and a status
+    chosen; a subclass is caught by every ``except KeyboardInterrupt`` all the same.
+    """
+
+
 def signal_label(signum: int) -> str:
     """``"SIGINT (Ctrl+C)"`` or ``"SIGTERM"``: a signal as the messages name it."""
     name = signal.Signals(signum).name

@@ -13,7 +13,7 @@ from __future__ import annotations
 import sys
 from types import FrameType
 
-from explaindrive.cli._signals import HANDLED_SIGNALS, exit_status, signal_label
+from explaindrive.cli._signals import HANDLED_SIGNALS, SignalInterrupt, exit_status, signal_label
 
 
 def main() -> None:
@@ -25,7 +25,7 @@ def main() -> None:
     def stop(signum: int, frame: FrameType | None) -> None:
         received.append(signum)
         if len(received) == 1:
-            raise KeyboardInterrupt
+            raise SignalInterrupt
 
     for sig in HANDLED_SIGNALS:
         signal.signal(sig, stop)

@@ -83,6 +83,7 @@ def evaluate_command(
     if (problem := grid.check_ray_target(ray, ray_address)) is not None:
         err_console.print(error_line(problem))
         raise typer.Exit(2)
+    _check_policies(spec)
     records = _run(plan, workers, ray, ray_address)
     _print_tables(plan.name, spec, records, episodes)
     if json_file is not None:
@@ -91,6 +92,19 @@ def evaluate_command(
     if figures is not None:
         for path in _write_figures(plan, spec, records, figures):
             err_console.print(f"wrote {path}")
+
+
+def _check_policies(spec: PolicySpec) -> None:
+    """Load the policy files once before the run: one that is not a policy ends the command
+    with one line and status 2, before any episode."""
+    from explaindrive.agent.checkpoint import CheckpointError, load_policy
+
+    try:
+        for path in spec.paths:
+            load_policy(Path(path))
+    except CheckpointError as exc:
+        err_console.print(error_line(exc))
+        raise typer.Exit(2) from None
 
 
 def _run(plan: RunPlan, workers: int | None, ray: bool, ray_address: str | None) -> list[Any]:

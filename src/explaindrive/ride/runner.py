@@ -89,10 +89,12 @@ def staging_dir(out_dir: Path) -> Path:
 
 
 def prepare_out_dir(out_dir: Path, force: bool = False) -> Path:
-    """Check that ``out_dir`` can take a new ride and make a fresh staging folder for it.
+    """Check that ``out_dir`` can take a new ride; returns the staging folder to write it into.
 
-    Nothing in ``out_dir`` is touched: a previous ride's files are replaced by
-    :func:`commit_ride` once the new ride has a record of its own.
+    Nothing is created and nothing in ``out_dir`` is touched: :func:`run_ride` makes the
+    staging folder, and :func:`commit_ride` replaces a previous ride's files once the new
+    ride has a record of its own. A staging folder left by a ride that was killed outright
+    (SIGKILL) is removed.
 
     Args:
         out_dir: the ride's output folder (need not exist).
@@ -100,11 +102,11 @@ def prepare_out_dir(out_dir: Path, force: bool = False) -> Path:
             at the end; anything else is kept) instead of refusing.
 
     Returns:
-        The empty staging folder (:func:`staging_dir`) the ride is written into.
+        The staging folder (:func:`staging_dir`).
 
     Raises:
-        OutputDirError: if ``out_dir`` is a file, holds files and ``force`` is off, or the
-            staging folder cannot be made.
+        OutputDirError: if ``out_dir`` is a file, holds files and ``force`` is off, or
+            cannot be made (a file on the way, no permission).
     """
     if out_dir.exists() and not out_dir.is_dir():
         raise OutputDirError(f"--out {out_dir} is a file, not a folder; name a folder")
@@ -115,12 +117,13 @@ def prepare_out_dir(out_dir: Path, force: bool = False) -> Path:
             f"--out {out_dir} is not empty ({shown}); choose a new folder, or add --force "
             "to replace the ride in it"
         )
+    parent = next(p for p in out_dir.parents if p.exists())  # "." or "/" at the latest
+    if not parent.is_dir():
+        raise OutputDirError(f"--out {out_dir}: {parent} is a file, not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputDirError(f"--out {out_dir} cannot be made in {parent} (permission denied)")
     staging = staging_dir(out_dir)
-    try:
-        shutil.rmtree(staging, ignore_errors=True)  # left by a ride killed outright
-        staging.mkdir(parents=True)
-    except OSError as exc:
-        raise OutputDirError(f"--out {out_dir} cannot be written: {exc.strerror}") from exc
+    shutil.rmtree(staging, ignore_errors=True)
     return staging
 
 

@@ -13,6 +13,9 @@ time. This module adds what it lacks, as its own HTTP protocol class
   is waiting, the new one is closed), so a request sent in one go is still answered;
 - a connection must send a complete request head within ``header_timeout_s`` of opening,
   or of its previous response;
+- a WebSocket handshake the app refuses (:class:`~explaindrive.web.guard.RequestGuard`
+  answers it with an HTTP status) is logged as one INFO line, without uvicorn's spurious
+  ERROR "returned without completing handshake" (:class:`RefusableWebSocketProtocol`);
 - a log message repeats at most ``log_lines`` times in ``log_window_s`` (tracebacks only
   the first time); the next line that gets through says how many were dropped.
 
@@ -32,11 +35,13 @@ from typing import Any
 import h11
 import uvicorn
 from uvicorn.protocols.http.h11_impl import H11Protocol
+from uvicorn.protocols.websockets.websockets_sansio_impl import WebSocketsSansIOProtocol
 
 log = logging.getLogger(__name__)
 
 FD_RESERVE = 160  # open files kept free of connections: models, SUMO, logs, an accept burst
 UVICORN_LOGGERS = ("uvicorn", "uvicorn.error", "uvicorn.access", "asyncio")
+WS_LIBRARY_LOGGER = f"{__name__}.websockets"  # the websockets library's lines per connection
 
 
 @dataclass(frozen=True)
@@ -121,6 +126,23 @@ def guarded_protocol(max_connections: int, header_timeout_s: float) -> type[H11P
     return GuardedH11Protocol
 
 
+class RefusableWebSocketProtocol(WebSocketsSansIOProtocol):
+    """uvicorn's WebSocket protocol, for which an HTTP answer to the handshake (a refusal)
+    completes it. uvicorn logs the refusal at INFO, then, as if the app had sent nothing,
+    an ERROR, and the websockets library logs it a second time at INFO; this class keeps
+    uvicorn's INFO line only (the library's own lines go to :data:`WS_LIBRARY_LOGGER`)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.conn.logger = logging.getLogger(WS_LIBRARY_LOGGER)
+
+    async def send(self, message: Any) -> None:
+        """Send ``message``; the last body part of an HTTP answer ends the handshake."""
+        await super().send(message)
+        if message["type"] == "websocket.http.response.body" and not message.get("more_body"):
+            self.handshake_complete = True
+
+
 class RateLimitFilter(logging.Filter):
     """Lets each log message (logger and format string) through at most ``lines`` times
     per ``window_s``, with its traceback only the first time; the next line let through
@@ -180,6 +202,7 @@ def server_config(app: Any, host: str, port: int, limits: ServerLimits) -> uvico
         port=port,
         log_level="warning",
         http=guarded_protocol(budget, limits.header_timeout_s),
+        ws=RefusableWebSocketProtocol,
         timeout_keep_alive=limits.keep_alive_s,
         limit_concurrency=budget + FD_RESERVE // 2,  # 503 past it; connections stay below
         backlog=256,
