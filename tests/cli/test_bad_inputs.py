@@ -120,7 +120,10 @@ BATTERY: list[tuple[list[str], str]] = [
         "error: long.flac: the recording is longer than 600 s; say the request in a sentence "
         "or two",
     ),
-    (["interpret", "--config", "latin1.yaml", "go faster"], "error: ..."),
+    (
+        ["interpret", "--config", "latin1.yaml", "go faster"],
+        "error: latin1.yaml: not UTF-8 text (byte 13: invalid continuation byte)",
+    ),
     (["serve", "--port", "0"], "error: Invalid value for '--port': ..."),
 ]
 
