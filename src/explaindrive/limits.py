@@ -25,6 +25,10 @@ MAX_WORKERS = 256
 MAX_EPISODES = 10_000_000
 """The most training episodes of one run (the paper's agents train 11,000)."""
 
+MAX_REPLAY = 20_000_000
+"""Transitions a training run's replay buffer holds at most (about 1.6 GB, allocated when
+the run starts; the paper's 5M take about 400 MB)."""
+
 MAX_COOLDOWN_S = 3_600.0
 """[s] The longest explanation cool-down of a ride."""
 

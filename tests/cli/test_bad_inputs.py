@@ -103,6 +103,11 @@ BATTERY: list[tuple[list[str], str]] = [
         ["train", "--mode", "fast", "--episodes", "0"],
         "error: Invalid value for '--episodes' / '-n': ...",
     ),
+    (
+        ["train", "--mode", "fast", "--set", "buffer_size=1000000000000"],
+        "error: invalid training config: buffer_size: Input should be less than or equal to "
+        "20000000, got 1000000000000",
+    ),
     (["score", "intents", "--json", "adir"], "error: --json adir is a folder; name a file"),
     (["score", "decisions", "--json", "adir"], "error: --json adir is a folder; name a file"),
     (
