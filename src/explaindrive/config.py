@@ -32,7 +32,6 @@ from pydantic import (
     ValidationError,
 )
 
-from explaindrive.limits import MAX_STEPS
 from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
 from explaindrive.validation import describe_error
 
@@ -145,9 +144,6 @@ TrafficLevel = Annotated[float, BeforeValidator(validate_traffic_level)]
 
 Seed = Annotated[int, BeforeValidator(validate_seed)]
 """A simulation seed in [0, :data:`~explaindrive.sim.scenario.layout.SEED_LIMIT`)."""
-
-StepLimit = Annotated[int, Field(gt=0, le=MAX_STEPS)]
-"""The step limit of an episode or a ride, in [1, :data:`~explaindrive.limits.MAX_STEPS`]."""
 
 
 def one_of(choices: tuple[str, ...]) -> AfterValidator:

@@ -8,10 +8,15 @@ docs/evaluation.md and docs/ride.md list them all.
 
 from __future__ import annotations
 
+from pydantic import Field
+
 from explaindrive.sim.scenario.layout import SEED_LIMIT
 
 MAX_STEPS = 7_200
 """[steps of 1 s] The longest episode or ride: two hours of driving."""
+
+STEP_LIMIT = Field(le=MAX_STEPS)
+"""Marks a config field that holds a step limit: ``Annotated[PositiveInt, STEP_LIMIT]``."""
 
 MAX_SEED = SEED_LIMIT - 1
 """The largest simulation seed (seeds are in [0, 2**31))."""
@@ -31,6 +36,9 @@ the run starts; the paper's 5M take about 400 MB)."""
 
 MAX_COOLDOWN_S = 3_600.0
 """[s] The longest explanation cool-down of a ride."""
+
+COOLDOWN_LIMIT = Field(le=MAX_COOLDOWN_S)
+"""Marks a config field that holds a cool-down: ``Annotated[NonNegativeFloat, COOLDOWN_LIMIT]``."""
 
 MAX_FILE_AUDIO_S = 600.0
 """[s] The longest recording ``transcribe`` and a ride script's audio lines decode; a

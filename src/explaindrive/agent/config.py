@@ -26,6 +26,7 @@ from pydantic import (
     model_validator,
 )
 
+from explaindrive import limits
 from explaindrive.commands import Command
 from explaindrive.config import (
     FROM_LIST,
@@ -37,7 +38,6 @@ from explaindrive.config import (
     read_yaml,
 )
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
-from explaindrive.limits import MAX_EPISODES, MAX_REPLAY, MAX_WORKERS
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 TRAIN_MODES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
@@ -59,10 +59,10 @@ class TrainConfig(ConfigModel):
 
     mode: str = "fast"
     """Primary command the agent is trained for: ``fast`` or ``comfort`` (both learn stop)."""
-    episodes: Annotated[int, Field(gt=0, le=MAX_EPISODES)] = 11_000
+    episodes: Annotated[int, Field(gt=0, le=limits.MAX_EPISODES)] = 11_000
     """Number of training episodes (the paper: 11,000), at most
     :data:`~explaindrive.limits.MAX_EPISODES`."""
-    num_envs: Annotated[int, Field(gt=0, le=MAX_WORKERS)] | None = None
+    num_envs: Annotated[int, Field(gt=0, le=limits.MAX_WORKERS)] | None = None
     """Parallel SUMO processes (at most :data:`~explaindrive.limits.MAX_WORKERS`); ``None``
     means ``os.cpu_count()``."""
     seed: Seed = 0
@@ -82,7 +82,7 @@ class TrainConfig(ConfigModel):
     """Threshold of the Huber loss (only with ``loss="huber"``)."""
     grad_clip_norm: PositiveFloat | None = None
     """Max global gradient norm; ``None`` disables clipping."""
-    buffer_size: Annotated[int, Field(gt=0, le=MAX_REPLAY)] = 5_000_000
+    buffer_size: Annotated[int, Field(gt=0, le=limits.MAX_REPLAY)] = 5_000_000
     """Replay capacity in transitions (the paper: 5M), at most
     :data:`~explaindrive.limits.MAX_REPLAY` (about 80 B each, allocated at the start)."""
     batch_size: PositiveInt = 64

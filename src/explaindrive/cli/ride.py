@@ -14,12 +14,15 @@ on an error writes the same and exits with status 1.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import queue
+import signal
 import sys
 import threading
+from collections.abc import Callable
 from pathlib import Path
 from types import FrameType
-from typing import TYPE_CHECKING, Annotated, NoReturn
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn
 
 import typer
 from rich.console import Console
@@ -27,7 +30,7 @@ from rich.live import Live
 
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
-from explaindrive.cli._signals import exit_status, handle_signals, signal_label
+from explaindrive.cli._signals import HANDLED_SIGNALS, exit_status, handle_signals, signal_label
 from explaindrive.language.config import LanguageConfig
 from explaindrive.limits import MAX_SEED
 from explaindrive.redact import redact
@@ -52,15 +55,6 @@ if TYPE_CHECKING:
     from explaindrive.ride.session import RideSession
 
 console = Console()
-
-
-class _StartupInterrupted(BaseException):
-    """A signal arrived before the ride's first step (``BaseException``: no library code
-    that catches ``Exception`` while the models load may swallow it)."""
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signum)
-        self.signum = signum
 
 
 # What the passenger says, and how requests are confirmed
@@ -120,50 +114,33 @@ def ride(
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     if voice and not interactive:
         _refuse("--voice needs --interactive")
-    stop = StopRequest()
-
-    def on_signal(signum: int, frame: FrameType | None) -> None:
-        if not driving:
-            raise _StartupInterrupted(signum)
-        stop.request(signum)  # the ride ends after this step; later signals change nothing
-
-    driving = False
-    staging: Path | None = None
-    with handle_signals(on_signal):
-        try:
-            try:
-                config = RideConfig(
-                    traffic_level=traffic,
-                    seed=seed,
-                    max_steps=max_steps,
-                    backend=backend,
-                    auto_confirm=auto_confirm,
-                    stop_without_confirm=stop_without_confirm,
-                    explanation_cooldown_s=cooldown,
-                    realtime=realtime or interactive,
-                    gui=gui,
-                    fast_policy=fast_policy,
-                    comfort_policy=comfort_policy,
-                )
-                language_config = LanguageConfig()
-                lines = _script_lines(script, interactive, max_steps)
-                staging = prepare_out_dir(out, force)
-            except (ValueError, ScriptError, OutputDirError) as exc:
-                _refuse(exc)
-            session = _build_session(config, language_config, lines, speech=voice)
-            typed = _passenger_input(voice) if interactive else None
-            if script is None and not interactive:
-                console.print(f"default ride script: {default_script_path()}")
-            driving = True
-        except _StartupInterrupted as exc:
-            if staging is not None:
-                discard_ride(staging)
-            _exit_unchanged(exc.signum, out)
-        assert staging is not None  # set, or the command was refused
-        outputs = _run(session, lines, staging, out, typed, live, stop)
-        _print_summary(session, outputs)
-        if outputs.interrupted is not None:
-            _exit_interrupted(session, outputs, stop.signum)
+    try:
+        config = RideConfig(
+            traffic_level=traffic,
+            seed=seed,
+            max_steps=max_steps,
+            backend=backend,
+            auto_confirm=auto_confirm,
+            stop_without_confirm=stop_without_confirm,
+            explanation_cooldown_s=cooldown,
+            realtime=realtime or interactive,
+            gui=gui,
+            fast_policy=fast_policy,
+            comfort_policy=comfort_policy,
+        )
+        language_config = LanguageConfig()
+        lines = _script_lines(script, interactive, max_steps)
+        staging = prepare_out_dir(out, force)
+    except (ValueError, ScriptError, OutputDirError) as exc:
+        _refuse(exc)
+    session = _build_session(config, language_config, lines, speech=voice)
+    typed = _passenger_input(voice) if interactive else None
+    if script is None and not interactive:
+        console.print(f"default ride script: {default_script_path()}")
+    outputs = _run(session, lines, staging, out, typed, live)
+    _print_summary(session, outputs)
+    if outputs.interrupted is not None:
+        _exit_interrupted(session, outputs)
 
 
 def _script_lines(script: Path | None, interactive: bool, max_steps: int) -> list[ScriptLine]:
@@ -178,7 +155,7 @@ def _script_lines(script: Path | None, interactive: bool, max_steps: int) -> lis
     return load_script(script or default_script_path(), max_time_s=float(max_steps))
 
 
-def _exit_interrupted(session: RideSession, outputs: RideOutputs, signum: int) -> NoReturn:
+def _exit_interrupted(session: RideSession, outputs: RideOutputs) -> NoReturn:
     """Say how the ride was interrupted and exit with status 128 + the signal's number."""
     console.print(
         f"the ride was {outputs.interrupted} after {len(session.records)} s; "
@@ -186,7 +163,34 @@ def _exit_interrupted(session: RideSession, outputs: RideOutputs, signum: int) -
         soft_wrap=True,
         highlight=False,
     )
-    raise typer.Exit(exit_status(signum))
+    raise typer.Exit(exit_status(outputs.signum or signal.SIGINT))
+
+
+class _StartupInterrupted(BaseException):
+    """A signal before the ride's first step (``BaseException``: no library code that
+    catches ``Exception`` while the models load may swallow it)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _end_start_up_on_signals(command: Callable[..., None]) -> Callable[..., None]:
+    """``command`` with SIGINT and SIGTERM ending it at once, ``--out`` unchanged, until
+    :func:`_run` takes them over for the drive (the handlers before it return at the end)."""
+
+    @functools.wraps(command)
+    def run(**options: Any) -> None:
+        def start_up(signum: int, frame: FrameType | None) -> None:
+            raise _StartupInterrupted(signum)
+
+        try:
+            with handle_signals(start_up):
+                command(**options)
+        except _StartupInterrupted as exc:
+            _exit_unchanged(exc.signum, options["out"])
+
+    return run
 
 
 def _exit_unchanged(signum: int, out: Path) -> NoReturn:
@@ -232,14 +236,18 @@ def _run(
     out: Path,
     typed: queue.Queue[str] | None,
     live: bool,
-    stop: StopRequest,
 ) -> RideOutputs:
     """Run the ride into ``staging``, then move it into ``out`` if it drove at least one
-    step; an error ends in one line and status 1, a stop before the first step leaves
-    ``out`` as it was."""
+    step. From here on a signal stops the ride after the current step (and later ones
+    change nothing); an error ends in one line and status 1; a stop before the first step
+    leaves ``out`` as it was."""
     from explaindrive.ride.runner import run_ride
     from explaindrive.ride.view import render
 
+    stop = StopRequest()
+    if threading.current_thread() is threading.main_thread():
+        for sig in HANDLED_SIGNALS:  # the command's own handlers come back when it ends
+            signal.signal(sig, lambda signum, _frame: stop.request(signum))
     try:
         if live and sys.stdout.isatty():
             with Live(render(session, None), console=console, refresh_per_second=8) as view:
@@ -270,7 +278,9 @@ def _run(
         discard_ride(staging)
         _exit_unchanged(stop.signum, out)
     final = commit_ride(staging, out)
-    return dataclasses.replace(final, interrupted=outputs.interrupted)
+    return dataclasses.replace(
+        outputs, events=final.events, summary=final.summary, figure=final.figure
+    )
 
 
 def _passenger_input(voice: bool) -> queue.Queue[str]:
@@ -321,4 +331,4 @@ def _print_summary(session: RideSession, outputs: RideOutputs) -> None:
 
 def register(app: typer.Typer) -> None:
     """Add the command to the CLI."""
-    app.command("ride")(ride)
+    app.command("ride")(_end_start_up_on_signals(ride))

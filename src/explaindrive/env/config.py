@@ -7,8 +7,9 @@ from typing import Annotated, Any
 
 from pydantic import NonNegativeInt, PositiveInt
 
-from explaindrive.config import ConfigModel, StepLimit, TextPath, TrafficLevel, one_of
+from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
+from explaindrive.limits import STEP_LIMIT
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
@@ -18,8 +19,7 @@ class EnvConfig(ConfigModel):
 
     Attributes:
         traffic_level: demand scale; 1.0 = 900 veh/h on the ego's main road.
-        max_steps: step limit of an episode (truncation) [steps of 1 s], at most
-            :data:`~explaindrive.limits.MAX_STEPS`.
+        max_steps: step limit of an episode (truncation) [steps of 1 s].
         warmup_s: simulated time before the ego enters [s]; the state is cached.
         normalize_obs: return observations scaled into [-1, 1] (see ``env.state``).
         net_file: a SUMO network to use instead of the shipped scenario.
@@ -37,7 +37,7 @@ class EnvConfig(ConfigModel):
     config_name = "env config"
 
     traffic_level: TrafficLevel = 1.0
-    max_steps: StepLimit = 1000
+    max_steps: Annotated[PositiveInt, STEP_LIMIT] = 1000  # at most 7,200
     warmup_s: NonNegativeInt = 180
     normalize_obs: bool = False
     net_file: TextPath | None = None

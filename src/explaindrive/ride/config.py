@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import AfterValidator, Field, NonNegativeFloat
+from pydantic import AfterValidator, NonNegativeFloat, PositiveInt
 
-from explaindrive.config import ConfigModel, Seed, StepLimit, TextPath, TrafficLevel
+from explaindrive.config import ConfigModel, Seed, TextPath, TrafficLevel
 from explaindrive.language.backends import check_backend
-from explaindrive.limits import MAX_COOLDOWN_S
+from explaindrive.limits import COOLDOWN_LIMIT, STEP_LIMIT
 
 
 class RideConfig(ConfigModel):
@@ -17,7 +17,7 @@ class RideConfig(ConfigModel):
     Attributes:
         traffic_level: demand scale, in (0, 1.75] (1.0 = 900 veh/h on the main road).
         seed: simulation seed.
-        max_steps: longest ride [steps of 1 s], at most :data:`~explaindrive.limits.MAX_STEPS`.
+        max_steps: longest ride [steps of 1 s].
         backend: language backend (``embedded`` or ``openai``).
         auto_confirm: answer every confirmation question with yes.
         stop_without_confirm: apply a STOP request as soon as it is understood.
@@ -38,11 +38,11 @@ class RideConfig(ConfigModel):
 
     traffic_level: TrafficLevel = 1.0
     seed: Seed = 0
-    max_steps: StepLimit = 600
+    max_steps: Annotated[PositiveInt, STEP_LIMIT] = 600  # at most 7,200
     backend: Annotated[str, AfterValidator(check_backend)] = "embedded"
     auto_confirm: bool = False
     stop_without_confirm: bool = False
-    explanation_cooldown_s: Annotated[float, Field(ge=0.0, le=MAX_COOLDOWN_S)] = 15.0
+    explanation_cooldown_s: Annotated[NonNegativeFloat, COOLDOWN_LIMIT] = 15.0  # <= 3,600
     interpret_deadline_s: NonNegativeFloat = 2.0
     audio_deadline_s: NonNegativeFloat = 8.0
     explain_deadline_s: NonNegativeFloat = 1.0

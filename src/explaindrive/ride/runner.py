@@ -70,12 +70,14 @@ class OutputDirError(ValueError):
 
 @dataclass(frozen=True)
 class RideOutputs:
-    """Files a ride wrote, and why it ended early (``None``: it ran to its end)."""
+    """Files a ride wrote, why it ended early (``None``: it ran to its end) and the signal
+    that ended it, if one did."""
 
     events: Path
     summary: Path
     figure: Path
     interrupted: str | None = None
+    signum: int | None = None
 
 
 def output_files(out_dir: Path) -> RideOutputs:
@@ -223,10 +225,11 @@ def run_ride(
                 events.catch_up(session.records, lag=0)
     finally:
         session.close()
-    _finish(session, todo, outputs, events.written, reason, signum if reason else None)
+    signum = signum if reason else None
+    _finish(session, todo, outputs, events.written, reason, signum)
     if failure is not None:
         raise failure
-    return RideOutputs(outputs.events, outputs.summary, outputs.figure, reason)
+    return RideOutputs(outputs.events, outputs.summary, outputs.figure, reason, signum)
 
 
 def _drive(
