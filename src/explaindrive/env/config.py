@@ -7,9 +7,9 @@ from typing import Annotated, Any
 
 from pydantic import NonNegativeInt, PositiveInt
 
+from explaindrive import limits
 from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
-from explaindrive.limits import STEP_LIMIT
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
 
@@ -37,7 +37,7 @@ class EnvConfig(ConfigModel):
     config_name = "env config"
 
     traffic_level: TrafficLevel = 1.0
-    max_steps: Annotated[PositiveInt, STEP_LIMIT] = 1000  # at most 7,200
+    max_steps: Annotated[PositiveInt, limits.STEP_LIMIT] = 1000  # at most 7,200
     warmup_s: NonNegativeInt = 180
     normalize_obs: bool = False
     net_file: TextPath | None = None
