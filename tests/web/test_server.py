@@ -91,7 +91,7 @@ def small_server(monkeypatch: pytest.MonkeyPatch) -> Iterator[tuple[int, list[lo
     config = server_config(app, "127.0.0.1", port, ServerLimits(header_timeout_s=600.0))
     seen: list[logging.LogRecord] = []
     handler = logging.Handler()
-    handler.emit = seen.append  # type: ignore[method-assign]
+    handler.emit = seen.append  # type: ignore[assignment]
     error_log = logging.getLogger("uvicorn.error")
     error_log.addHandler(handler)
     error_log.setLevel(logging.INFO)
@@ -146,11 +146,12 @@ def test_a_refused_websocket_is_logged_once_at_info(
 ) -> None:
     from websockets.exceptions import InvalidStatus
     from websockets.sync.client import connect
+    from websockets.typing import Origin
 
     port, seen = small_server
     seen.clear()  # the start-up lines
     with pytest.raises(InvalidStatus, match="HTTP 403"):
-        connect(f"ws://127.0.0.1:{port}/ws", origin="http://elsewhere.example").close()
+        connect(f"ws://127.0.0.1:{port}/ws", origin=Origin("http://elsewhere.example")).close()
     time.sleep(0.3)  # uvicorn's spurious ERROR came after the app returned
     assert [r.levelname for r in seen] == ["INFO"]
     assert seen[0].getMessage().endswith('"WebSocket /ws" 403')
