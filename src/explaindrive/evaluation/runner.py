@@ -8,11 +8,14 @@ back in the order of the grid, so the backend does not change the numbers.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import logging
 import multiprocessing
 import os
-from collections.abc import Callable, Sequence
+import signal
+import threading
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
@@ -185,17 +188,43 @@ def run_grid(
 def _run_pool(
     specs: list[EpisodeSpec], workers: int, progress: Progress | None
 ) -> list[EpisodeRecord]:
+    from concurrent.futures import as_completed
+
     ctx = multiprocessing.get_context("spawn")
     results: list[EpisodeRecord | None] = [None] * len(specs)
-    with ProcessPoolExecutor(workers, mp_context=ctx, initializer=_worker_init) as pool:
+    with _children_ignore_sigint():  # Ctrl+C reaches the terminal's whole process group
+        pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_worker_init)
         futures = {pool.submit(run_episode, spec): i for i, spec in enumerate(specs)}
-        from concurrent.futures import as_completed
-
+    try:
         for done, future in enumerate(as_completed(futures), start=1):
             results[futures[future]] = future.result()
             if progress:
                 progress(done, len(specs))
+    except BaseException:  # Ctrl+C, or an episode that failed: stop the others now
+        pool.shutdown(wait=False, cancel_futures=True)
+        processes = dict(getattr(pool, "_processes", None) or {})  # no public handle
+        for process in processes.values():
+            with contextlib.suppress(OSError):
+                process.terminate()
+        raise
+    pool.shutdown()
     return [r for r in results if r is not None]
+
+
+@contextlib.contextmanager
+def _children_ignore_sigint() -> Iterator[None]:
+    """Processes started in the block ignore SIGINT from their first instruction on (an
+    ignored signal stays ignored across ``exec``, and Python then keeps it so): a Ctrl+C
+    stops the run in this process alone, which ends the workers, and none of them prints
+    a traceback. Outside the main thread nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _run_ray(
