@@ -13,9 +13,7 @@ import functools
 import logging
 import multiprocessing
 import os
-import signal
-import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
@@ -26,6 +24,7 @@ from explaindrive.commands import Command
 from explaindrive.env.actions import IDLE_ACTION
 from explaindrive.env.metrics import EpisodeMetrics, EpisodeResult
 from explaindrive.evaluation.spec import EpisodeSpec, PolicySpec
+from explaindrive.processes import children_ignore_sigint
 
 log = logging.getLogger(__name__)
 
@@ -192,7 +191,7 @@ def _run_pool(
 
     ctx = multiprocessing.get_context("spawn")
     results: list[EpisodeRecord | None] = [None] * len(specs)
-    with _children_ignore_sigint():  # Ctrl+C reaches the terminal's whole process group
+    with children_ignore_sigint():  # Ctrl+C stops the run here; the workers are ended
         pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_worker_init)
         futures = {pool.submit(run_episode, spec): i for i, spec in enumerate(specs)}
     try:
@@ -209,22 +208,6 @@ def _run_pool(
         raise
     pool.shutdown()
     return [r for r in results if r is not None]
-
-
-@contextlib.contextmanager
-def _children_ignore_sigint() -> Iterator[None]:
-    """Processes started in the block ignore SIGINT from their first instruction on (an
-    ignored signal stays ignored across ``exec``, and Python then keeps it so): a Ctrl+C
-    stops the run in this process alone, which ends the workers, and none of them prints
-    a traceback. Outside the main thread nothing changes."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 def _run_ray(
