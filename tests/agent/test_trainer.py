@@ -100,11 +100,20 @@ def test_resume_refuses_a_mismatched_or_corrupt_checkpoint(tmp_path: Path) -> No
         train(tiny(episodes=4, hidden_sizes=[8]), tmp_path, env_factory=FACTORY, resume=True)
     assert str(ckpt) in str(err.value)
     ckpt.write_bytes(b"not a checkpoint")
-    with pytest.raises(CheckpointError, match="corrupt") as err:
+    with pytest.raises(CheckpointError, match="is not an explaindrive checkpoint file") as err:
         train(tiny(episodes=4), tmp_path, env_factory=FACTORY, resume=True)
     assert str(ckpt) in str(err.value)
     with pytest.raises(CheckpointError, match="not found"):
         train(tiny(episodes=4), tmp_path / "empty", env_factory=FACTORY, resume=True)
+
+
+def test_a_run_stopped_before_its_first_checkpoint_starts_afresh(tmp_path: Path) -> None:
+    train(tiny(episodes=3, checkpoint_every_episodes=100), tmp_path, env_factory=FACTORY)
+    (tmp_path / "checkpoints" / "checkpoint.pt").unlink()  # as if killed before it was written
+    assert len(rows(tmp_path)) == 3
+    train(tiny(episodes=5), tmp_path, env_factory=FACTORY)
+    assert [int(r["episode"]) for r in rows(tmp_path)] == [0, 1, 2, 3, 4]  # not 3 + 5 rows
+    assert "left no checkpoint; this run starts it afresh" in (tmp_path / "train.log").read_text()
 
 
 def test_subprocess_envs_collect_in_parallel(tmp_path: Path) -> None:

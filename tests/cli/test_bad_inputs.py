@@ -18,14 +18,14 @@ pytestmark = pytest.mark.slow  # a subprocess per case
 ENV = {**os.environ, "COLUMNS": "50", "TERM": "dumb", "NO_COLOR": "1"}
 
 
-def run(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+def run(*args: str, cwd: Path, timeout_s: float = 120) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [sys.executable, "-m", "explaindrive.cli.main", *args],
         cwd=cwd,
         env=ENV,
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=timeout_s,
     )
 
 
@@ -33,7 +33,118 @@ def one_error_line(res: subprocess.CompletedProcess[str]) -> str:
     lines = (res.stdout + res.stderr).strip().splitlines()
     assert res.returncode == 2, res.stdout + res.stderr
     assert len(lines) == 1 and lines[0].startswith("error: "), lines
+    assert "Traceback" not in res.stdout + res.stderr
     return lines[0]
+
+
+def make_inputs(root: Path) -> None:
+    """The files the battery names: a file, a folder, text that is not UTF-8, a policy file
+    that is not one, and 700 s of (silent, so tiny) FLAC audio."""
+    import numpy as np
+    import soundfile as sf
+
+    (root / "afile").write_text("x")
+    (root / "adir").mkdir()
+    (root / "latin1.yaml").write_bytes(b"lr: 0.001 # d\xe9faut\n")
+    (root / "corrupt.pt").write_bytes(b"PK\x03\x04 not a policy" * 20)
+    sf.write(root / "long.flac", np.zeros(16_000 * 700, dtype=np.int16), 16_000)
+
+
+# (arguments, the error line; "..." at its end: the line starts with the text before it)
+BATTERY: list[tuple[list[str], str]] = [
+    (["ride", "--out", "afile/ride"], "error: --out afile/ride: afile is a file, not a folder"),
+    (
+        ["ride", "--max-steps", "1000000000"],
+        "error: invalid ride config: max_steps: Input should be less than or equal to 7200, "
+        "got 1000000000",
+    ),
+    (["ride", "--seed", "-1"], "error: Invalid value for '--seed': ..."),
+    (["ride", "--cooldown", "1e9"], "error: invalid ride config: explanation_cooldown_s: ..."),
+    (
+        ["ride", "--fast-policy", "corrupt.pt"],
+        "error: corrupt.pt is not an explaindrive policy file (torch cannot read it: ...",
+    ),
+    (["demo", "--seed", "-1"], "error: Invalid value for '--seed': ..."),
+    (
+        ["evaluate", "fast", "--seeds", "0-99999999"],
+        "error: seed list '0-99999999' names 100000000 or more seeds; at most 1000 in a run",
+    ),
+    (
+        ["evaluate", "fast", "--max-steps", "1000000000"],
+        "error: Invalid value for '--max-steps': Input should be less than or equal to 7200",
+    ),
+    (["evaluate", "fast", "--workers", "100000"], "error: Invalid value for '--workers': ..."),
+    (
+        ["evaluate", "fast", "--ray-address", "bogus:1"],
+        "error: no Ray cluster answers at --ray-address bogus:1 (...",
+    ),
+    (["evaluate", "fast", "--json", "adir"], "error: --json adir is a folder; name a file"),
+    (
+        ["evaluate", "fast", "--figures", "afile"],
+        "error: --figures afile is a file, not a folder; name a folder",
+    ),
+    (
+        ["evaluate", "corrupt.pt", "--seeds", "0"],
+        "error: corrupt.pt is not an explaindrive policy file (torch cannot read it: ...",
+    ),
+    (
+        ["train", "--mode", "fast", "--out", "afile"],
+        "error: --out afile is a file, not a folder; name a folder",
+    ),
+    (
+        ["train", "--mode", "fast", "--config", "latin1.yaml"],
+        "error: config file latin1.yaml is not UTF-8 text (byte 13: invalid continuation byte)",
+    ),
+    (
+        ["train", "--mode", "fast", "--ray-address", "bogus:1"],
+        "error: no Ray cluster answers at --ray-address bogus:1 (...",
+    ),
+    (
+        ["train", "--mode", "fast", "--episodes", "0"],
+        "error: Invalid value for '--episodes' / '-n': ...",
+    ),
+    (
+        ["train", "--mode", "fast", "--set", "buffer_size=1000000000000"],
+        "error: invalid training config: buffer_size: Input should be less than or equal to "
+        "20000000, got 1000000000000",
+    ),
+    (["score", "intents", "--json", "adir"], "error: --json adir is a folder; name a file"),
+    (["score", "decisions", "--json", "adir"], "error: --json adir is a folder; name a file"),
+    (
+        ["scenario", "build", "--out", "afile"],
+        "error: --out afile is a file, not a folder; name a folder",
+    ),
+    (["scenario", "plot", "--out", "adir"], "error: --out adir is a folder; name a file"),
+    (["report", "--out", "adir"], "error: --out adir is a folder; name a file"),
+    (
+        ["report", "--json", "afile/r.json"],
+        "error: --json afile/r.json: afile is a file, not a folder",
+    ),
+    (
+        ["transcribe", "long.flac"],
+        "error: long.flac: the recording is longer than 600 s; say the request in a sentence "
+        "or two",
+    ),
+    (
+        ["interpret", "--config", "latin1.yaml", "go faster"],
+        "error: latin1.yaml: not UTF-8 text (byte 13: invalid continuation byte)",
+    ),
+    (["serve", "--port", "0"], "error: Invalid value for '--port': ..."),
+]
+
+
+@pytest.mark.parametrize(("args", "expected"), BATTERY, ids=[" ".join(args) for args, _ in BATTERY])
+def test_bad_input_is_one_line_and_exit_2_within_15_s(
+    tmp_path: Path, args: list[str], expected: str
+) -> None:
+    make_inputs(tmp_path)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    line = one_error_line(run(*args, cwd=tmp_path, timeout_s=15 * 4))  # 15 s on a free CPU
+    if expected.endswith("..."):
+        assert line.startswith(expected[:-3]), line
+    else:
+        assert line == expected
+    assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing made, nothing lost
 
 
 def test_ride_out_naming_a_file(tmp_path: Path) -> None:

@@ -48,6 +48,17 @@ def test_bad_seeds(text: str, message: str) -> None:
         parse_seeds(text)
 
 
+def test_a_seed_list_holds_at_most_a_thousand_seeds() -> None:
+    assert len(parse_seeds("0-999")) == 1000
+    assert len(parse_seeds("0-499,1000-1499")) == 1000
+    with pytest.raises(SpecError, match="names 1001 or more seeds; at most 1000 in a run"):
+        parse_seeds("0-1000")
+    with pytest.raises(SpecError, match="names 1001 or more seeds"):
+        parse_seeds("0-999,5000")
+    with pytest.raises(SpecError, match="names 100000000 or more seeds"):
+        parse_seeds("0-99999999")  # refused before the range is expanded
+
+
 def test_levels() -> None:
     assert parse_levels("0.5,0.75,1.0,1.25,1.5") == (0.5, 0.75, 1.0, 1.25, 1.5)
     for text, message in [("x", "not a number"), ("0", "> 0"), ("-1", "> 0"),

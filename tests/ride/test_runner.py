@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import signal
 import threading
 from pathlib import Path
 
@@ -13,8 +14,12 @@ from explaindrive.ride.runner import (
     STOPPED,
     WRITE_LAG_STEPS,
     OutputDirError,
+    StopRequest,
+    commit_ride,
+    discard_ride,
     prepare_out_dir,
     run_ride,
+    staging_dir,
 )
 from explaindrive.ride.script import ScriptLine
 from explaindrive.ride.session import RideSession, StepRecord
@@ -41,6 +46,7 @@ def test_a_finished_ride_is_not_marked_interrupted(tmp_path: Path) -> None:
     assert outputs.interrupted is None
     done = summary(tmp_path)
     assert (done["steps"], done["interrupted"], done["interruption"]) == (25, False, None)
+    assert done["signal"] is None
     assert [e["t"] for e in event_lines(tmp_path)] == [float(t) for t in range(1, 26)]
     assert done["unused_script_lines"] == [
         {"t": 30.0, "say": "hurry", "audio": None, "confirm": None}
@@ -109,18 +115,69 @@ def test_a_ride_that_fails_writes_its_steps_then_raises(tmp_path: Path) -> None:
     assert result["interruption"] == "stopped on an error: RuntimeError: SUMO went away"
 
 
-def test_prepare_out_dir(tmp_path: Path) -> None:
+def test_prepare_out_dir_checks_the_folder_and_touches_nothing_in_it(tmp_path: Path) -> None:
     new = tmp_path / "a" / "b"
-    prepare_out_dir(new)
-    assert new.is_dir()
+    assert prepare_out_dir(new) == tmp_path / "a" / ".b.new"
+    assert list(tmp_path.iterdir()) == []  # nothing is made before the ride
     (tmp_path / "file").write_text("x")
     with pytest.raises(OutputDirError, match="is a file, not a folder"):
         prepare_out_dir(tmp_path / "file")
+    with pytest.raises(OutputDirError, match=r"file/ride: .*file is a file, not a folder"):
+        prepare_out_dir(tmp_path / "file" / "ride")
+    new.mkdir(parents=True)
     for name in ("events.jsonl", "summary.json", "ride.png", "notes.txt"):
         (new / name).write_text("old ride")
     with pytest.raises(
         OutputDirError, match=r"not empty \(events.jsonl, notes.txt, ride.png, \.\.\.\).*--force"
     ):
         prepare_out_dir(new)
-    prepare_out_dir(new, force=True)
-    assert [p.name for p in new.iterdir()] == ["notes.txt"]  # only a ride's own files go
+    staging_dir(new).mkdir()
+    (staging_dir(new) / "events.jsonl").write_text("a ride killed outright")
+    staging = prepare_out_dir(new, force=True)
+    assert not staging.exists()  # removed; run_ride makes it afresh
+    assert sorted(p.read_text() for p in new.iterdir()) == ["old ride"] * 4  # all kept
+
+
+def test_a_committed_ride_replaces_the_previous_one_and_keeps_other_files(tmp_path: Path) -> None:
+    out = tmp_path / "ride"
+    out.mkdir()
+    for name in ("events.jsonl", "summary.json", "ride.png", "notes.txt"):
+        (out / name).write_text("old ride")
+    staging = prepare_out_dir(out, force=True)
+    run_ride(make_session(max_steps=5), [], staging)
+    final = commit_ride(staging, out)
+    assert final.summary == out / "summary.json" and summary(out)["steps"] == 5
+    assert len(event_lines(out)) == 5 and (out / "notes.txt").read_text() == "old ride"
+    assert not staging.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ride"]
+
+
+def test_a_discarded_ride_leaves_the_previous_one_as_it_was(tmp_path: Path) -> None:
+    out = tmp_path / "ride"
+    out.mkdir()
+    (out / "summary.json").write_text("old ride")
+    staging = prepare_out_dir(out, force=True)
+    staging.mkdir()
+    (staging / "events.jsonl").write_text("")
+    discard_ride(staging)
+    assert [p.name for p in tmp_path.iterdir()] == ["ride"]
+    assert (out / "summary.json").read_text() == "old ride"
+
+
+def test_a_stop_request_names_its_signal_in_the_summary(tmp_path: Path) -> None:
+    stop = StopRequest()
+
+    def terminate_at_4(rec: StepRecord) -> None:
+        if rec.t >= 4:
+            stop.request(signal.SIGTERM)
+            stop.request(signal.SIGINT)  # a later signal changes nothing
+
+    outputs = run_ride(make_session(), [], tmp_path, on_step=terminate_at_4, stop=stop)
+    assert outputs.interrupted == "stopped by SIGTERM"
+    result = summary(tmp_path)
+    assert (result["steps"], result["interruption"], result["signal"]) == (
+        4,
+        "stopped by SIGTERM",
+        "SIGTERM",
+    )
+    assert STOPPED == "stopped by SIGINT (Ctrl+C)"

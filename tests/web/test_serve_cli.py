@@ -24,12 +24,13 @@ def test_unknown_backend_exits_before_serving() -> None:
 
 
 def test_the_served_names_reach_the_app(monkeypatch: pytest.MonkeyPatch) -> None:
-    import uvicorn
-
+    from explaindrive.web import server
     from explaindrive.web.guard import RequestGuard
 
     served: dict[str, object] = {}
-    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.update(app=app, **kw))
+    monkeypatch.setattr(
+        server, "run_server", lambda app, host, port: served.update(app=app, host=host)
+    )
     res = runner.invoke(app, ["serve", "--host", "0.0.0.0", "--allow-host", "Car.Local"])
     assert res.exit_code == 0, res.output
     assert "exposes the ride controls" in res.output and served["host"] == "0.0.0.0"
@@ -46,15 +47,16 @@ def test_a_missing_policy_exits_before_serving(tmp_path: Path) -> None:
 def test_a_trained_network_reaches_the_rides(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
-    import uvicorn
-
+    from explaindrive.web import server
     from explaindrive.web.app import RealStack
 
     run = tmp_path / "run"  # a training run directory
     run.mkdir()
     constant_policy(run / "policy.pt", 0, {"name": "mine"})
     served: dict[str, object] = {}
-    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.update(app=app, **kw))
+    monkeypatch.setattr(
+        server, "run_server", lambda app, host, port: served.update(app=app, host=host)
+    )
     res = runner.invoke(app, ["serve", "--fast-policy", str(run)])
     assert res.exit_code == 0, res.output
     stack = served["app"].state.manager.session_factory  # type: ignore[attr-defined]

@@ -119,8 +119,11 @@ def _torch_load(path: Path, what: str) -> dict[str, Any]:
         raise CheckpointError(f"{what} file not found: {path}")
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as exc:  # torch raises many types for a damaged file
-        raise CheckpointError(f"{what} file {path} is corrupt or unreadable: {exc}") from exc
+    except Exception as exc:  # torch raises many types (with long advice) for a damaged file
+        raise CheckpointError(
+            f"{path} is not an explaindrive {what} file (torch cannot read it: "
+            f"{type(exc).__name__})"
+        ) from exc
     if not isinstance(payload, dict):
         raise CheckpointError(f"{path} is not an explaindrive {what} file")
     return payload

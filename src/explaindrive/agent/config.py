@@ -26,6 +26,7 @@ from pydantic import (
     model_validator,
 )
 
+from explaindrive import limits
 from explaindrive.commands import Command
 from explaindrive.config import (
     FROM_LIST,
@@ -61,10 +62,12 @@ class TrainConfig(ConfigModel, ScenarioFields):
 
     mode: str = "fast"
     """Primary command the agent is trained for: ``fast`` or ``comfort`` (both learn stop)."""
-    episodes: PositiveInt = 11_000
-    """Number of training episodes (the paper: 11,000)."""
-    num_envs: PositiveInt | None = None
-    """Parallel SUMO processes; ``None`` means ``os.cpu_count()``."""
+    episodes: Annotated[int, Field(gt=0, le=limits.MAX_EPISODES)] = 11_000
+    """Number of training episodes (the paper: 11,000), at most
+    :data:`~explaindrive.limits.MAX_EPISODES`."""
+    num_envs: Annotated[int, Field(gt=0, le=limits.MAX_WORKERS)] | None = None
+    """Parallel SUMO processes (at most :data:`~explaindrive.limits.MAX_WORKERS`); ``None``
+    means ``os.cpu_count()``."""
     seed: Seed = 0
     """Base seed of the run: episode seeds, exploration and network initialisation."""
 
@@ -82,8 +85,9 @@ class TrainConfig(ConfigModel, ScenarioFields):
     """Threshold of the Huber loss (only with ``loss="huber"``)."""
     grad_clip_norm: PositiveFloat | None = None
     """Max global gradient norm; ``None`` disables clipping."""
-    buffer_size: PositiveInt = 5_000_000
-    """Replay capacity in transitions (the paper: 5M)."""
+    buffer_size: Annotated[int, Field(gt=0, le=limits.MAX_REPLAY)] = 5_000_000
+    """Replay capacity in transitions (the paper: 5M), at most
+    :data:`~explaindrive.limits.MAX_REPLAY` (about 80 B each, allocated at the start)."""
     batch_size: PositiveInt = 64
     """Minibatch size (the paper: 64)."""
     gamma: float = Field(default=0.99, ge=0.0, lt=1.0)
@@ -280,11 +284,16 @@ def load_config_file(path: str | Path) -> dict[str, Any]:
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ConfigError(f"cannot read config file {path}: {exc}") from exc
+        raise ConfigError(f"cannot read config file {path}: {exc.strerror}") from exc
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"config file {path} is not UTF-8 text (byte {exc.start}: {exc.reason})"
+        ) from None
     try:
         data = json.loads(text) if path.suffix == ".json" else read_yaml(text)
     except (json.JSONDecodeError, yaml.YAMLError) as exc:
-        raise ConfigError(f"cannot parse config file {path}: {exc}") from exc
+        where = " ".join(str(exc).split())  # PyYAML's message spans lines
+        raise ConfigError(f"cannot parse config file {path}: {where}") from exc
     if data is None:
         return {}
     if not isinstance(data, dict):

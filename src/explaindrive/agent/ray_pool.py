@@ -13,6 +13,8 @@ from __future__ import annotations
 import importlib.util
 import logging
 import os
+import socket
+import threading
 import time
 from collections.abc import Sequence
 from dataclasses import replace
@@ -22,6 +24,7 @@ from typing import Any
 from explaindrive.agent.config import ConfigError, TrainConfig
 from explaindrive.agent.rollout import CollectRequest, EnvFactory, Rollout, RolloutWorker
 from explaindrive.agent.workers import RoundResult, WorkerLost
+from explaindrive.limits import RAY_CONNECT_TIMEOUT_S
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +48,36 @@ def require_ray() -> ModuleType:
     import ray
 
     return ray
+
+
+def unreachable_ray_address(address: str, timeout_s: float = RAY_CONNECT_TIMEOUT_S) -> str | None:
+    """Why nothing answers at the Ray cluster ``address`` (``host:port`` or
+    ``ray://host:port``) within ``timeout_s``, or ``None`` if a TCP connection opens
+    (``auto`` and ``local`` are left to Ray). Ray itself retries an address that does not
+    answer for minutes; this check makes such a run fail at once.
+    """
+    if address in ("auto", "local"):
+        return None
+    host, sep, port = address.removeprefix("ray://").rpartition(":")
+    host = host.strip("[]")  # an IPv6 address in brackets
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        return f"--ray-address {address!r} is not host:port (e.g. 10.0.0.5:6379)"
+    outcome: list[str | None] = []
+
+    def connect() -> None:  # the name lookup has no timeout of its own: a thread bounds it
+        try:
+            with socket.create_connection((host, int(port)), timeout=timeout_s):
+                outcome.append(None)
+        except OSError as exc:
+            outcome.append(exc.strerror or type(exc).__name__)
+
+    worker = threading.Thread(target=connect, daemon=True, name="ray-address-check")
+    worker.start()
+    worker.join(timeout_s)
+    reason = outcome[0] if outcome else f"no answer within {timeout_s:g} s"
+    if reason is None:
+        return None
+    return f"no Ray cluster answers at --ray-address {address} ({reason})"
 
 
 class RayRolloutActor:

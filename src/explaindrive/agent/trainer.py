@@ -21,7 +21,9 @@ out with every round. No decision depends on timing, so a run is reproducible.
 Resume: the checkpoint holds the networks, the optimiser, the replay buffer, the counters,
 the RNG state and the episodes that were under way; ``resume=True`` reloads it, truncates
 the CSV to the episodes it had logged, and plays the interrupted episodes again with their
-original plans. Only the transitions collected after the checkpoint are lost.
+original plans. Only the transitions collected after the checkpoint are lost. A run that
+is not resumed writes ``episodes.csv`` afresh: the rows of a run stopped before its first
+checkpoint cannot be continued, and are never counted twice.
 """
 
 from __future__ import annotations
@@ -136,6 +138,7 @@ class Trainer:
         self.recent_returns: deque[float] = deque(maxlen=config.moving_average_window)
         self.source_commits = [git_commit()]  # the code of the start and of each resume
 
+        self.resumed = resume  # else episodes.csv starts afresh: no rows counted twice
         if resume:
             self._restore()
         elif (self.ckpt_dir / CHECKPOINT_FILE).exists():
@@ -221,8 +224,11 @@ class Trainer:
         c = self.config
         self.out_dir.mkdir(parents=True, exist_ok=True)
         atomic_write_text(self.out_dir / "config.json", c.to_json())
-        new_csv = not self.csv_path.exists()
-        csv_file = self.csv_path.open("a", newline="")
+        new_csv = not self.resumed or not self.csv_path.exists()
+        if not self.resumed and self.csv_path.exists():  # a run stopped before its checkpoint
+            self.note(logging.WARNING, "%s held episodes of a run that left no checkpoint; "
+                      "this run starts it afresh", self.csv_path)  # fmt: skip
+        csv_file = self.csv_path.open("w" if new_csv else "a", newline="")
         writer = csv.DictWriter(csv_file, fieldnames=CSV_FIELDS)
         if new_csv:
             writer.writeheader()

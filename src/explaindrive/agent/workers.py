@@ -25,6 +25,7 @@ from typing import Any, Protocol
 
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.rollout import CollectRequest, EnvFactory, Rollout, RolloutWorker
+from explaindrive.processes import children_ignore_sigint, restore_sigint
 
 log = logging.getLogger(__name__)
 
@@ -99,6 +100,7 @@ def _serve(
 ) -> None:
     """Process loop: build the worker, then answer ``collect`` until ``close``."""
     _end_with_parent(parent_pid)
+    restore_sigint()  # ignored while this process imported its modules
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     worker = None
     try:
@@ -141,7 +143,8 @@ class ProcessPool:
             parent, child = ctx.Pipe()
             proc = ctx.Process(target=_serve, args=(child, config, env_factory, i, os.getpid()),
                                name=f"explaindrive-worker-{i}", daemon=True)  # fmt: skip
-            proc.start()
+            with children_ignore_sigint():  # no traceback from a Ctrl+C during its imports
+                proc.start()
             child.close()
             self._conns.append(parent)
             self._procs.append(proc)

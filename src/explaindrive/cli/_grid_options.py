@@ -13,12 +13,13 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from explaindrive.cli._errors import error_line
+from explaindrive.limits import MAX_STEPS, MAX_WORKERS
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 if TYPE_CHECKING:
     from explaindrive.evaluation.runner import Progress as EpisodeProgress
 
-err_console = Console(stderr=True)
+err_console = Console(stderr=True, soft_wrap=True)  # an error line never wraps
 
 DEFAULT_TRAFFIC = ",".join(f"{x:g}" for x in TRAFFIC_LEVELS)
 
@@ -34,7 +35,8 @@ ShieldOption = Annotated[
     typer.Option("--shield/--no-shield", help="Agents act through the safety shield."),
 ]
 WorkersOption = Annotated[
-    int | None, typer.Option("--workers", min=1, help="Processes (default: one per CPU).")
+    int | None,
+    typer.Option("--workers", min=1, max=MAX_WORKERS, help="Processes (default: one per CPU)."),
 ]
 RayOption = Annotated[bool, typer.Option("--ray", help="Run the episodes on a local Ray.")]
 RayAddressOption = Annotated[
@@ -45,20 +47,23 @@ JsonOption = Annotated[
     Path | None, typer.Option("--json", help="Write every episode and the aggregates here.")
 ]
 MaxStepsOption = Annotated[
-    int, typer.Option("--max-steps", min=1, help="Step limit per episode [s].")
+    int, typer.Option("--max-steps", min=1, max=MAX_STEPS, help="Step limit per episode [s].")
 ]
 
 
 def check_ray_target(ray: bool, ray_address: str | None) -> str | None:
-    """The error message when both ``--ray`` and ``--ray-address`` are given, or when either
-    is given without Ray installed; else ``None``."""
+    """The error message when both ``--ray`` and ``--ray-address`` are given, when either
+    is given without Ray installed, or when nothing answers at ``--ray-address`` (within
+    :data:`~explaindrive.limits.RAY_CONNECT_TIMEOUT_S`); else ``None``."""
     if ray and ray_address:
         return "give --ray or --ray-address, not both"
     if ray or ray_address:
-        from explaindrive.agent.ray_pool import RAY_MISSING, ray_installed
+        from explaindrive.agent.ray_pool import RAY_MISSING, ray_installed, unreachable_ray_address
 
         if not ray_installed():
             return RAY_MISSING
+        if ray_address:
+            return unreachable_ray_address(ray_address)
     return None
 
 

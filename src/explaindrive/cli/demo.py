@@ -12,10 +12,11 @@ from explaindrive.env.config import EnvConfig
 from explaindrive.env.metrics import EpisodeMetrics
 from explaindrive.env.scripted import CautiousDriver
 from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.limits import MAX_SEED
 
 
 def demo(
-    seed: int = typer.Option(0, help="Episode seed."),
+    seed: int = typer.Option(0, min=0, max=MAX_SEED, help="Episode seed."),
     traffic: float = typer.Option(1.0, help="Traffic level (1.0 = 900 veh/h)."),
     command: str = typer.Option("fast", help="Passenger command: fast, comfort or stop."),
 ) -> None:

@@ -12,6 +12,7 @@ from explaindrive.cli import _grid_options as grid
 from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import error_line, print_error
 from explaindrive.cli._grid_options import err_console
+from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.evaluation.paper import PAPER_SEEDS
 
 if TYPE_CHECKING:
@@ -90,6 +91,7 @@ def evaluate_command(
         plan_run,
     )
 
+    refuse_bad_outputs(files=((json_file, "--json"),), folders=((figures, "--figures"),))
     try:
         spec = parse_policy(
             policy, fast_path=fast_policy, comfort_path=comfort_policy, shield=shield
@@ -107,6 +109,7 @@ def evaluate_command(
     if (problem := grid.check_ray_target(ray, ray_address)) is not None:
         err_console.print(error_line(problem))
         raise typer.Exit(2)
+    _check_policies(spec)
     records = _run(plan, workers, ray, ray_address)
     _print_scenario_tables(plan.name, spec, records, episodes)
     if json_file is not None:
@@ -166,6 +169,19 @@ def _print_scenario_tables(name: str, spec: PolicySpec, records: list[Any], epis
     elif records and records[0].spec.scenario_name != "paper":
         name = f"{name} on {records[0].spec.scenario_name}"
     _print_tables(name, spec, records, episodes and len(groups) == 1)
+
+
+def _check_policies(spec: PolicySpec) -> None:
+    """Load the policy files once before the run: one that is not a policy ends the command
+    with one line and status 2, before any episode."""
+    from explaindrive.agent.checkpoint import CheckpointError, load_policy
+
+    try:
+        for path in spec.paths:
+            load_policy(Path(path))
+    except CheckpointError as exc:
+        err_console.print(error_line(exc))
+        raise typer.Exit(2) from None
 
 
 def _run(plan: RunPlan, workers: int | None, ray: bool, ray_address: str | None) -> list[Any]:

@@ -50,4 +50,6 @@ for _name in _COMMAND_MODULES:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    app()
+    from explaindrive.cli.entry import main
+
+    main()

@@ -12,7 +12,9 @@ import typer
 from explaindrive.cli import _grid_options as grid
 from explaindrive.cli._errors import error_line
 from explaindrive.cli._grid_options import err_console
+from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.evaluation.spec import POLICY_NAMES
+from explaindrive.limits import MAX_SEEDS
 
 if TYPE_CHECKING:
     from explaindrive.evaluation.report import ReportPlan
@@ -25,7 +27,10 @@ FigureDirOption = Annotated[
     typer.Option("--figures", help="Figure directory (default: figures/ next to --out)."),
 ]
 EpisodesPerCellOption = Annotated[
-    int, typer.Option("--episodes-per-cell", min=1, help="Seeds per traffic level (paper: 5).")
+    int,
+    typer.Option(
+        "--episodes-per-cell", min=1, max=MAX_SEEDS, help="Seeds per traffic level (paper: 5)."
+    ),
 ]
 PoliciesOption = Annotated[
     str, typer.Option("--policies", help="Subset of " + ",".join(POLICY_NAMES) + ".")
@@ -72,6 +77,9 @@ def report_command(
     """Evaluate the policies and baselines and rewrite the results document and figures."""
     from explaindrive.evaluation.report import run_report
 
+    refuse_bad_outputs(
+        files=((out, "--out"), (json_file, "--json")), folders=((figures, "--figures"),)
+    )
     plan = _plan(policies, episodes_per_cell, traffic, fast_policy, comfort_policy, max_steps,
                  shield, ray, ray_address, seed_tables or [])  # fmt: skip
     n = sum(len(run.episodes) for run in plan.runs)

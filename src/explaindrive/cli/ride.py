@@ -1,23 +1,28 @@
 """``explaindrive ride``: the passenger ride, the project's main job.
 
 Bad settings, a bad script and an ``--out`` that cannot take the ride are refused with
-one line and exit status 2 before anything loads. Ctrl+C ends the ride after the
-current step (a second Ctrl+C at once): the steps driven, the figure and a summary
-marked ``interrupted`` are written, and the exit status is 130. A ride that stops on an
-error writes the same and exits with status 1.
+one line and exit status 2 before anything loads. The ride is written into a staging
+folder beside ``--out`` and moved into it at the end, so the previous ride there is
+replaced only by a ride with a record of its own. Ctrl+C (SIGINT) or SIGTERM while the
+models load ends the command at once and leaves ``--out`` as it was; while the car drives
+it ends the ride after the current step (further signals change nothing): the steps
+driven, the figure and a summary marked ``interrupted`` with the signal's name are
+written, and the exit status is 128 + the signal's number (130, 143). A ride that stops
+on an error writes the same and exits with status 1.
 """
 
 from __future__ import annotations
 
-import contextlib
+import dataclasses
+import functools
 import queue
 import signal
 import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable
 from pathlib import Path
 from types import FrameType
-from typing import TYPE_CHECKING, Annotated, NoReturn
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn
 
 import typer
 from rich.console import Console
@@ -26,10 +31,18 @@ from rich.live import Live
 from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
+from explaindrive.cli._signals import HANDLED_SIGNALS, exit_status, handle_signals, signal_label
 from explaindrive.language.config import LanguageConfig
+from explaindrive.limits import MAX_SEED
 from explaindrive.redact import redact
 from explaindrive.ride.config import RideConfig
-from explaindrive.ride.runner import OutputDirError, prepare_out_dir
+from explaindrive.ride.runner import (
+    OutputDirError,
+    StopRequest,
+    commit_ride,
+    discard_ride,
+    prepare_out_dir,
+)
 from explaindrive.ride.script import (
     AUDIO_PREFIX,
     ScriptError,
@@ -43,7 +56,6 @@ if TYPE_CHECKING:
     from explaindrive.ride.session import RideSession
 
 console = Console()
-EXIT_INTERRUPTED = 130  # the shell's status for a command ended by Ctrl+C
 
 
 # What the passenger says, and how requests are confirmed
@@ -69,7 +81,7 @@ BackendOption = Annotated[
 CooldownOption = Annotated[float, typer.Option("--cooldown", help="Explanation cool-down [s].")]
 # The simulation
 TrafficOption = Annotated[float, typer.Option("--traffic", help="Traffic level (1.0 = 900 veh/h).")]
-SeedOption = Annotated[int, typer.Option("--seed", help="Simulation seed.")]
+SeedOption = Annotated[int, typer.Option("--seed", min=0, max=MAX_SEED, help="Simulation seed.")]
 MaxStepsOption = Annotated[int, typer.Option("--max-steps", help="Longest ride [s].")]
 GuiOption = Annotated[bool, typer.Option("--gui", help="Show the ride in sumo-gui.")]
 ObsNoiseOption = Annotated[
@@ -140,14 +152,14 @@ def ride(
         )
         language_config = LanguageConfig()
         lines = _script_lines(script, interactive, max_steps)
-        prepare_out_dir(out, force)
+        staging = prepare_out_dir(out, force)
     except (ValueError, ScriptError, OutputDirError) as exc:
         _refuse(exc)
     session = _build_session(config, language_config, lines, speech=voice)
     typed = _passenger_input(voice) if interactive else None
     if script is None and not interactive:
         console.print(f"default ride script: {default_script_path()}")
-    outputs = _run(session, lines, out, typed, live)
+    outputs = _run(session, lines, staging, out, typed, live)
     _print_summary(session, outputs)
     if outputs.interrupted is not None:
         _exit_interrupted(session, outputs)
@@ -166,14 +178,51 @@ def _script_lines(script: Path | None, interactive: bool, max_steps: int) -> lis
 
 
 def _exit_interrupted(session: RideSession, outputs: RideOutputs) -> NoReturn:
-    """Say how the ride was interrupted and exit with status 130."""
+    """Say how the ride was interrupted and exit with status 128 + the signal's number."""
     console.print(
         f"the ride was {outputs.interrupted} after {len(session.records)} s; "
         f"{outputs.summary} marks it interrupted",
         soft_wrap=True,
         highlight=False,
     )
-    raise typer.Exit(EXIT_INTERRUPTED)
+    raise typer.Exit(exit_status(outputs.signum or signal.SIGINT))
+
+
+class _StartupInterrupted(BaseException):
+    """A signal before the ride's first step (``BaseException``: no library code that
+    catches ``Exception`` while the models load may swallow it)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _end_start_up_on_signals(command: Callable[..., None]) -> Callable[..., None]:
+    """``command`` with SIGINT and SIGTERM ending it at once, ``--out`` unchanged, until
+    :func:`_run` takes them over for the drive (the handlers before it return at the end)."""
+
+    @functools.wraps(command)
+    def run(**options: Any) -> None:
+        def start_up(signum: int, frame: FrameType | None) -> None:
+            raise _StartupInterrupted(signum)
+
+        try:
+            with handle_signals(start_up):
+                command(**options)
+        except _StartupInterrupted as exc:
+            _exit_unchanged(exc.signum, options["out"])
+
+    return run
+
+
+def _exit_unchanged(signum: int, out: Path) -> NoReturn:
+    """Say that a signal ended the command before the first step, and exit."""
+    console.print(
+        f"stopped by {signal_label(signum)} before the ride started; {out} is unchanged",
+        soft_wrap=True,
+        highlight=False,
+    )
+    raise typer.Exit(exit_status(signum))
 
 
 def _refuse(message: object) -> NoReturn:
@@ -205,60 +254,55 @@ def _build_session(
 def _run(
     session: RideSession,
     lines: list[ScriptLine],
+    staging: Path,
     out: Path,
     typed: queue.Queue[str] | None,
     live: bool,
 ) -> RideOutputs:
-    """Run the ride with Ctrl+C handled; an error ends in one line and status 1."""
+    """Run the ride into ``staging``, then move it into ``out`` if it drove at least one
+    step. From here on a signal stops the ride after the current step (and later ones
+    change nothing); an error ends in one line and status 1; a stop before the first step
+    leaves ``out`` as it was."""
     from explaindrive.ride.runner import run_ride
     from explaindrive.ride.view import render
 
-    stop = threading.Event()
+    stop = StopRequest()
+    if threading.current_thread() is threading.main_thread():
+        for sig in HANDLED_SIGNALS:  # the command's own handlers come back when it ends
+            signal.signal(sig, lambda signum, _frame: stop.request(signum))
     try:
-        with _stop_on_signals(stop):
-            if live and sys.stdout.isatty():
-                with Live(render(session, None), console=console, refresh_per_second=8) as view:
-                    return run_ride(
-                        session,
-                        lines,
-                        out,
-                        typed=typed,
-                        on_step=lambda rec: view.update(render(session, rec)),
-                        stop=stop,
-                    )
-            return run_ride(session, lines, out, typed=typed, stop=stop)
+        if live and sys.stdout.isatty():
+            with Live(render(session, None), console=console, refresh_per_second=8) as view:
+                outputs = run_ride(
+                    session,
+                    lines,
+                    staging,
+                    typed=typed,
+                    on_step=lambda rec: view.update(render(session, rec)),
+                    stop=stop,
+                )
+        else:
+            outputs = run_ride(session, lines, staging, typed=typed, stop=stop)
     except Exception as exc:
+        kept = session.records and (staging / "summary.json").is_file()
+        where = commit_ride(staging, out).summary if kept else None
+        discard_ride(staging)
         print_error(
             console,
             redact(
                 f"the ride stopped on an error after {len(session.records)} s "
-                f"({type(exc).__name__}: {exc}); {out / 'summary.json'} marks it interrupted"
+                f"({type(exc).__name__}: {exc}); "
+                + (f"{where} marks it interrupted" if where else f"{out} is unchanged")
             ),
         )
-        raise typer.Exit(1) from exc
-
-
-@contextlib.contextmanager
-def _stop_on_signals(stop: threading.Event) -> Iterator[None]:
-    """Ctrl+C (or SIGTERM) sets ``stop``; a second Ctrl+C raises ``KeyboardInterrupt``.
-
-    Outside the main thread (where signal handlers cannot be set) nothing changes.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum: int, frame: FrameType | None) -> None:
-        if stop.is_set() and signum == signal.SIGINT:
-            raise KeyboardInterrupt
-        stop.set()
-
-    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, old in previous.items():
-            signal.signal(sig, old)
+        raise typer.Exit(1) from None
+    if not session.records:
+        discard_ride(staging)
+        _exit_unchanged(stop.signum, out)
+    final = commit_ride(staging, out)
+    return dataclasses.replace(
+        outputs, events=final.events, summary=final.summary, figure=final.figure
+    )
 
 
 def _passenger_input(voice: bool) -> queue.Queue[str]:
@@ -309,4 +353,4 @@ def _print_summary(session: RideSession, outputs: RideOutputs) -> None:
 
 def register(app: typer.Typer) -> None:
     """Add the command to the CLI."""
-    app.command("ride")(ride)
+    app.command("ride")(_end_start_up_on_signals(ride))

@@ -8,6 +8,7 @@ import typer
 from rich.console import Console
 
 from explaindrive.cli._errors import error_line, print_error
+from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.sim.scenario.files import package_data_dir
 
 scenario_app = typer.Typer(help="Build or draw urban SUMO scenarios.", no_args_is_help=True)
@@ -27,6 +28,7 @@ def build(
     from explaindrive.sim.scenario.directory import write_scenario_dir
     from explaindrive.sim.scenario.params import ScenarioParams
 
+    refuse_bad_outputs(folders=((out, "--out"),))
     if not settings:
         net = build_network(out or package_data_dir())
         Console().print(f"network written to {net}")
@@ -57,6 +59,7 @@ def random(
     except ValueError as exc:
         print_error(Console(stderr=True), exc)
         raise typer.Exit(2) from None
+    refuse_bad_outputs(folders=((out, "--out"),))
     write_scenario_dir(out, params, f"random-{seed}", seed)
     Console().print(f"scenario random-{seed} written to {out}")
 
@@ -69,6 +72,7 @@ def plot(
     """Draw the network to a PNG."""
     from explaindrive.sim.scenario.plot import plot_network
 
+    refuse_bad_outputs(files=((out, "--out"),))
     net_file = net or package_data_dir() / "urban.net.xml"
     if not net_file.is_file():
         Console().print(error_line(f"network file not found: {net_file}"))

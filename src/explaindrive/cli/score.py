@@ -16,6 +16,7 @@ from explaindrive.cli._language_common import (
     fail,
     load_config,
 )
+from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.language.datasets import (
     DECISIONS_JSONL,
     TEST_CSV,
@@ -50,6 +51,7 @@ def intents_command(
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
+    refuse_bad_outputs(files=((out, "--json"),))
     try:
         rows = load_commands(data)
         from explaindrive.language.stack import make_language_stack
@@ -88,6 +90,7 @@ def decisions_command(
 ) -> None:
     """Trigger accuracy/precision/recall/F1, factor accuracy and checked explanations of
     LLM-2/LLM-3."""
+    refuse_bad_outputs(files=((out, "--json"),))
     try:
         rows = load_decisions(data)
         from explaindrive.language.stack import make_language_stack

@@ -1,4 +1,4 @@
-"""``explaindrive serve``: the passenger web interface."""
+"""``explaindrive serve``: the passenger web interface (limits: :mod:`explaindrive.web.server`)."""
 
 from __future__ import annotations
 
@@ -42,13 +42,12 @@ def serve(
     demand: where.DemandOption = None,
 ) -> None:
     """Serve the passenger page: watch the ride, talk to the car, read its explanations."""
-    import uvicorn
-
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.controller import MergedController
     from explaindrive.web import create_app
     from explaindrive.web.app import RealStack
     from explaindrive.web.guard import LOOPBACK_HOSTS, served_hosts
+    from explaindrive.web.server import run_server
 
     try:  # before the server starts
         check_backend(backend)
@@ -68,7 +67,7 @@ def serve(
     stack = RealStack(backend, fast_policy, comfort_policy, place)
     app = create_app(stack, step_period_s=step_period, hosts=hosts, net_file=where.net_of(place))
     console.print(f"passenger page: http://{host}:{port}/  (Ctrl+C to stop)")
-    uvicorn.run(app, host=host, port=port, log_level="warning")
+    run_server(app, host, port)
 
 
 def register(app: typer.Typer) -> None:

@@ -22,6 +22,8 @@ from explaindrive.agent.config import (
 from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import check_ray_target
+from explaindrive.cli._paths import refuse_bad_outputs
+from explaindrive.limits import MAX_EPISODES, MAX_WORKERS
 
 if TYPE_CHECKING:
     from explaindrive.agent.trainer import TrainResult
@@ -74,9 +76,15 @@ def resolve_config(
 
 
 ModeOption = Annotated[str, typer.Option("--mode", "-m", help="Agent to train: fast or comfort.")]
-EpisodesOption = Annotated[int | None, typer.Option("--episodes", "-n", help="Training episodes.")]
+EpisodesOption = Annotated[
+    int | None,
+    typer.Option("--episodes", "-n", min=1, max=MAX_EPISODES, help="Training episodes."),
+]
 EnvsOption = Annotated[
-    int | None, typer.Option("--envs", help="Parallel SUMO processes (default: CPU count).")
+    int | None,
+    typer.Option(
+        "--envs", min=1, max=MAX_WORKERS, help="Parallel SUMO processes (default: CPU count)."
+    ),
 ]
 OutOption = Annotated[
     Path | None, typer.Option("--out", "-o", help="Run directory (default: runs/<mode>).")
@@ -152,6 +160,7 @@ def train_command(
         _train_seeds(mode, seeds, seed, out, run_args)
         return
     out = out or Path("runs") / mode
+    refuse_bad_outputs(folders=((out, "--out"),))
     try:
         if (problem := check_ray_target(ray, ray_address)) is not None:
             raise ConfigError(problem)

@@ -7,6 +7,7 @@ from typing import Annotated, Any
 
 from pydantic import Field, NonNegativeInt, PositiveInt
 
+from explaindrive import limits
 from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
 from explaindrive.env.noise import NoiseSD, ObservationNoise
@@ -45,7 +46,7 @@ class EnvConfig(ConfigModel, ScenarioFields):
     config_name = "env config"
 
     traffic_level: TrafficLevel = 1.0
-    max_steps: PositiveInt = 1000
+    max_steps: Annotated[PositiveInt, limits.STEP_LIMIT] = 1000  # at most 7,200
     warmup_s: NonNegativeInt = 180
     normalize_obs: bool = False
     cache_dir: TextPath | None = None

@@ -8,6 +8,7 @@ back in the order of the grid, so the backend does not change the numbers.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import logging
 import multiprocessing
@@ -23,6 +24,7 @@ from explaindrive.commands import Command
 from explaindrive.env.actions import IDLE_ACTION
 from explaindrive.env.metrics import EpisodeMetrics, EpisodeResult
 from explaindrive.evaluation.spec import EpisodeSpec, PolicySpec
+from explaindrive.processes import children_ignore_sigint
 
 log = logging.getLogger(__name__)
 
@@ -189,16 +191,26 @@ def run_grid(
 def _run_pool(
     specs: list[EpisodeSpec], workers: int, progress: Progress | None
 ) -> list[EpisodeRecord]:
+    from concurrent.futures import as_completed
+
     ctx = multiprocessing.get_context("spawn")
     results: list[EpisodeRecord | None] = [None] * len(specs)
-    with ProcessPoolExecutor(workers, mp_context=ctx, initializer=_worker_init) as pool:
+    with children_ignore_sigint():  # Ctrl+C stops the run here; the workers are ended
+        pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_worker_init)
         futures = {pool.submit(run_episode, spec): i for i, spec in enumerate(specs)}
-        from concurrent.futures import as_completed
-
+    try:
         for done, future in enumerate(as_completed(futures), start=1):
             results[futures[future]] = future.result()
             if progress:
                 progress(done, len(specs))
+    except BaseException:  # Ctrl+C, or an episode that failed: stop the others now
+        pool.shutdown(wait=False, cancel_futures=True)
+        processes = dict(getattr(pool, "_processes", None) or {})  # no public handle
+        for process in processes.values():
+            with contextlib.suppress(OSError):
+                process.terminate()
+        raise
+    pool.shutdown()
     return [r for r in results if r is not None]
 
 

@@ -17,12 +17,14 @@ from __future__ import annotations
 import itertools
 import json
 import math
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from explaindrive.commands import COMMAND_LABELS, Command
+from explaindrive.limits import MAX_SEEDS, MAX_STEPS
 from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
 
 BASELINES: tuple[str, ...] = ("krauss", "idm")
@@ -120,12 +122,18 @@ def _seed(token: str, text: str) -> int:
     return value
 
 
+def _check_seed_count(n: int, text: str) -> None:
+    if n > MAX_SEEDS:
+        raise SpecError(f"seed list {text!r} names {n} or more seeds; at most {MAX_SEEDS} in a run")
+
+
 def parse_seeds(text: str) -> tuple[int, ...]:
     """Parse ``0-4``, ``0,3,7`` or ``0-4,10`` into distinct seeds, in the given order.
 
     Raises:
-        SpecError: on a non-integer, a negative or too large seed, a reversed range or a
-            duplicate.
+        SpecError: on a non-integer, a negative or too large seed, a reversed range, more
+            than :data:`~explaindrive.limits.MAX_SEEDS` seeds (checked before a range is
+            expanded) or a duplicate.
     """
     seeds: list[int] = []
     for item in _items(text, "seed list"):
@@ -134,10 +142,13 @@ def parse_seeds(text: str) -> tuple[int, ...]:
             lo, hi = _seed(head.strip(), text), _seed(tail.strip(), text)
             if hi < lo:
                 raise SpecError(f"seed range {item!r} is reversed (use {hi}-{lo})")
+            _check_seed_count(len(seeds) + hi - lo + 1, text)
             seeds.extend(range(lo, hi + 1))
         else:
+            _check_seed_count(len(seeds) + 1, text)
             seeds.append(_seed(item, text))
-    dupes = sorted({s for s in seeds if seeds.count(s) > 1})
+    counts = Counter(seeds)
+    dupes = sorted(s for s, n in counts.items() if n > 1)
     if dupes:
         raise SpecError(f"seed list {text!r} repeats seed(s) {dupes}")
     return tuple(seeds)
@@ -366,6 +377,8 @@ def build_grid(
         raise SpecError("the grid is empty: give at least one seed and one traffic level")
     if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps <= 0:
         raise SpecError(f"max_steps must be a positive integer, got {max_steps!r}")
+    if max_steps > MAX_STEPS:
+        raise SpecError(f"--max-steps {max_steps} is too long; at most {MAX_STEPS} [s]")
     first = command or policy.primary
     sched = tuple((float(t), Command.parse(c).label) for t, c in schedule)
     check_schedule(policy, first, sched)

@@ -114,6 +114,8 @@ class LanguageConfig(_Strict):
             raise FileNotFoundError(f"language config not found: {p}")
         try:
             raw = yaml.safe_load(p.read_text(encoding="utf-8")) or {}
+        except UnicodeDecodeError as exc:
+            raise ValueError(f"{p}: not UTF-8 text (byte {exc.start}: {exc.reason})") from None
         except yaml.YAMLError as exc:
             raise ValueError(f"{p}: not valid YAML: {exc}") from exc
         if not isinstance(raw, dict):

@@ -13,6 +13,7 @@ import numpy as np
 
 from explaindrive.language.config import SpeechConfig
 from explaindrive.language.packaged import WHISPER_TINY_EN, packaged_model_dir
+from explaindrive.limits import MAX_FILE_AUDIO_S
 
 log = logging.getLogger(__name__)
 
@@ -69,7 +70,9 @@ def load_audio(path: str | Path, config: SpeechConfig | None = None) -> np.ndarr
     """Decode an audio file to 16 kHz mono float32 and check that it holds sound.
 
     Raises:
-        AudioError: if the file is missing, not WAV/FLAC/MP3, undecodable, empty or silent.
+        AudioError: if the file is missing, not WAV/FLAC/MP3, undecodable, longer than
+            :data:`~explaindrive.limits.MAX_FILE_AUDIO_S` (found out after decoding that
+            much of it, never more), empty or silent.
     """
     cfg = config or SpeechConfig()
     p = Path(path)
@@ -82,12 +85,15 @@ def load_audio(path: str | Path, config: SpeechConfig | None = None) -> np.ndarr
         )
     if p.stat().st_size == 0:
         raise AudioError(f"{p.name}: the file is empty")
-    from faster_whisper import decode_audio
+    from explaindrive.audio import AudioRejectedError, decode_bounded
 
-    try:
-        audio = np.asarray(decode_audio(str(p), sampling_rate=SAMPLE_RATE_HZ), dtype=np.float32)
-    except Exception as exc:  # PyAV raises many types for bad input
-        raise AudioError(f"{p.name}: cannot decode audio (corrupt or not audio): {exc}") from exc
+    try:  # bounded: a long file stops decoding at the limit, in bounded memory
+        samples = decode_bounded(p, max_duration_s=MAX_FILE_AUDIO_S)
+    except AudioRejectedError as exc:
+        if exc.status_code == 413:  # longer than the limit
+            raise AudioError(f"{p.name}: {exc}") from None
+        raise AudioError(f"{p.name}: cannot decode audio (corrupt or not audio): {exc}") from None
+    audio = samples.astype(np.float32) / 32768.0  # as faster-whisper scales 16-bit samples
     duration = len(audio) / SAMPLE_RATE_HZ
     if duration < cfg.min_duration_s:
         raise AudioError(f"{p.name}: audio is empty or too short ({duration:.2f} s)")

@@ -9,6 +9,7 @@ from pydantic import AfterValidator, Field, NonNegativeFloat, PositiveInt
 from explaindrive.config import ConfigModel, Seed, TextPath, TrafficLevel
 from explaindrive.env.noise import NoiseSD
 from explaindrive.language.backends import check_backend
+from explaindrive.limits import COOLDOWN_LIMIT, STEP_LIMIT
 from explaindrive.sim.scenario.choice import ScenarioFields
 
 
@@ -41,11 +42,11 @@ class RideConfig(ConfigModel, ScenarioFields):
 
     traffic_level: TrafficLevel = 1.0
     seed: Seed = 0
-    max_steps: PositiveInt = 600
+    max_steps: Annotated[PositiveInt, STEP_LIMIT] = 600  # at most 7,200
     backend: Annotated[str, AfterValidator(check_backend)] = "embedded"
     auto_confirm: bool = False
     stop_without_confirm: bool = False
-    explanation_cooldown_s: NonNegativeFloat = 15.0
+    explanation_cooldown_s: Annotated[NonNegativeFloat, COOLDOWN_LIMIT] = 15.0  # <= 3,600
     interpret_deadline_s: NonNegativeFloat = 2.0
     audio_deadline_s: NonNegativeFloat = 8.0
     explain_deadline_s: NonNegativeFloat = 1.0

@@ -1,11 +1,15 @@
 """Run a ride to its end: script lines in, ``events.jsonl``/``summary.json``/``ride.png`` out.
 
-The output folder holds one ride at every moment: :func:`prepare_out_dir` refuses a
-folder that holds anything (unless told to replace a previous ride's files), steps are
-appended to ``events.jsonl`` as soon as late language results can no longer change
-them, and the figure and the summary are written last, each under a temporary name
-first. A ride that is stopped (Ctrl+C, see ``stop``) or fails still writes every step
-it drove, then its figure and its summary, marked ``interrupted`` with the reason.
+A ride never costs the record of an earlier one: :func:`prepare_out_dir` checks the output
+folder (refused if it holds anything, unless told to replace a previous ride) and makes a
+fresh staging folder next to it, ``.<name>.new``; the ride writes there, and
+:func:`commit_ride` moves its files into the output folder only once they are complete
+(the summary last). A ride stopped before its first step is dropped with
+:func:`discard_ride`, leaving the folder as it was. Steps are appended to ``events.jsonl``
+as soon as late language results can no longer change them, and the figure and the
+summary are written last, each under a temporary name first. A ride that is stopped
+(a signal, see ``stop``) or fails still writes every step it drove, then its figure and
+its summary, marked ``interrupted`` with the reason and the signal's name.
 """
 
 from __future__ import annotations
@@ -14,6 +18,8 @@ import json
 import logging
 import os
 import queue
+import shutil
+import signal
 import threading
 import time
 from collections import deque
@@ -33,7 +39,29 @@ log = logging.getLogger(__name__)
 
 WRITE_LAG_STEPS = 3  # records are written once late language results can no longer change them
 EVENTS_NAME, SUMMARY_NAME, FIGURE_NAME = "events.jsonl", "summary.json", "ride.png"
-STOPPED = "stopped by the passenger (Ctrl+C)"
+
+
+def stop_reason(signum: int) -> str:
+    """``"stopped by SIGINT (Ctrl+C)"``: how a ride ended by the signal ``signum`` is marked."""
+    name = signal.Signals(signum).name
+    return f"stopped by {name}" + (" (Ctrl+C)" if signum == signal.SIGINT else "")
+
+
+STOPPED = stop_reason(signal.SIGINT)  # Ctrl+C, or a stop without a reason
+
+
+class StopRequest(threading.Event):
+    """A ride's stop flag that keeps the signal that set it (the first one counts)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.signum: int = signal.SIGINT
+
+    def request(self, signum: int) -> None:
+        """Stop the ride after the current step, because of ``signum``."""
+        if not self.is_set():
+            self.signum = signum
+            self.set()
 
 
 class OutputDirError(ValueError):
@@ -42,12 +70,14 @@ class OutputDirError(ValueError):
 
 @dataclass(frozen=True)
 class RideOutputs:
-    """Files a ride wrote, and why it ended early (``None``: it ran to its end)."""
+    """Files a ride wrote, why it ended early (``None``: it ran to its end) and the signal
+    that ended it, if one did."""
 
     events: Path
     summary: Path
     figure: Path
     interrupted: str | None = None
+    signum: int | None = None
 
 
 def output_files(out_dir: Path) -> RideOutputs:
@@ -55,31 +85,66 @@ def output_files(out_dir: Path) -> RideOutputs:
     return RideOutputs(out_dir / EVENTS_NAME, out_dir / SUMMARY_NAME, out_dir / FIGURE_NAME)
 
 
-def prepare_out_dir(out_dir: Path, force: bool = False) -> RideOutputs:
-    """Make ``out_dir`` ready for a new ride: created if missing, refused if it holds files.
+def staging_dir(out_dir: Path) -> Path:
+    """The folder a ride for ``out_dir`` is written into first: ``.<name>.new`` beside it."""
+    return out_dir.parent / f".{out_dir.name}.new"
+
+
+def prepare_out_dir(out_dir: Path, force: bool = False) -> Path:
+    """Check that ``out_dir`` can take a new ride; returns the staging folder to write it into.
+
+    Nothing is created and nothing in ``out_dir`` is touched: :func:`run_ride` makes the
+    staging folder, and :func:`commit_ride` replaces a previous ride's files once the new
+    ride has a record of its own. A staging folder left by a ride that was killed outright
+    (SIGKILL) is removed.
 
     Args:
-        out_dir: the ride's output folder.
-        force: delete a previous ride's files (``events.jsonl``, ``summary.json``,
-            ``ride.png``) instead of refusing; anything else in the folder is kept.
+        out_dir: the ride's output folder (need not exist).
+        force: accept a folder that already holds files (a previous ride's are replaced
+            at the end; anything else is kept) instead of refusing.
+
+    Returns:
+        The staging folder (:func:`staging_dir`).
 
     Raises:
-        OutputDirError: if ``out_dir`` is a file, or holds files and ``force`` is off.
+        OutputDirError: if ``out_dir`` is a file, holds files and ``force`` is off, or
+            cannot be made (a file on the way, no permission).
     """
     if out_dir.exists() and not out_dir.is_dir():
         raise OutputDirError(f"--out {out_dir} is a file, not a folder; name a folder")
-    out_dir.mkdir(parents=True, exist_ok=True)
-    outputs = output_files(out_dir)
-    entries = sorted(p.name for p in out_dir.iterdir())
+    entries = sorted(p.name for p in out_dir.iterdir()) if out_dir.is_dir() else []
     if entries and not force:
         shown = ", ".join(entries[:3]) + (", ..." if len(entries) > 3 else "")
         raise OutputDirError(
             f"--out {out_dir} is not empty ({shown}); choose a new folder, or add --force "
             "to replace the ride in it"
         )
-    for path in (outputs.events, outputs.summary, outputs.figure):
-        path.unlink(missing_ok=True)
-    return outputs
+    parent = next(p for p in out_dir.parents if p.exists())  # "." or "/" at the latest
+    if not parent.is_dir():
+        raise OutputDirError(f"--out {out_dir}: {parent} is a file, not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputDirError(f"--out {out_dir} cannot be made in {parent} (permission denied)")
+    staging = staging_dir(out_dir)
+    shutil.rmtree(staging, ignore_errors=True)
+    return staging
+
+
+def commit_ride(staging: Path, out_dir: Path) -> RideOutputs:
+    """Move a finished (or interrupted) ride's files from ``staging`` into ``out_dir``,
+    replacing a previous ride's; the summary goes last, so a summary in ``out_dir`` always
+    belongs to the events beside it once the move is over. ``staging`` is removed."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    new, final = output_files(staging), output_files(out_dir)
+    for src, dst in ((new.events, final.events), (new.figure, final.figure),
+                     (new.summary, final.summary)):  # fmt: skip
+        os.replace(src, dst)
+    discard_ride(staging)
+    return final
+
+
+def discard_ride(staging: Path) -> None:
+    """Remove a staging folder and whatever a ride left in it."""
+    shutil.rmtree(staging, ignore_errors=True)
 
 
 def _json_default(value: Any) -> Any:
@@ -122,16 +187,17 @@ def run_ride(
     Args:
         session: a fresh ride session (started here).
         lines: timed passenger lines (already validated).
-        out_dir: where ``events.jsonl``, ``summary.json`` and ``ride.png`` go (see
-            :func:`prepare_out_dir`; created here if missing).
+        out_dir: where ``events.jsonl``, ``summary.json`` and ``ride.png`` go (the CLI
+            passes the staging folder of :func:`prepare_out_dir`; created here if missing).
         typed: lines typed by the passenger while the ride runs (interactive mode);
             "yes"/"no" answers a pending confirmation question.
         on_step: called after every step (live view).
-        stop: when set, the ride ends after the current step and is marked interrupted.
+        stop: when set, the ride ends after the current step and is marked interrupted
+            (with the signal of a :class:`StopRequest`, else as by Ctrl+C).
 
     Returns:
         The files written; ``interrupted`` says why the ride ended early (``stop`` set,
-        or a ``KeyboardInterrupt``, which ends the ride the same way).
+        or a ``KeyboardInterrupt``, which ends the ride as Ctrl+C does).
 
     Raises:
         Exception: whatever error stopped the ride, once the outputs are written.
@@ -141,26 +207,29 @@ def run_ride(
     todo = deque(lines)
     failure: Exception | None = None
     reason: str | None = None
+    signum: int | None = None
     try:
         session.start()
         with outputs.events.open("w", encoding="utf-8") as fh:
             events = _EventLog(fh)
             try:
                 _drive(session, todo, events, typed, on_step, stop)
-                reason = None if session.done else STOPPED
+                signum = stop.signum if isinstance(stop, StopRequest) else signal.SIGINT
+                reason = None if session.done else stop_reason(signum)
             except KeyboardInterrupt:
-                reason = STOPPED
+                signum, reason = signal.SIGINT, STOPPED
             except Exception as exc:
-                failure = exc
+                failure, signum = exc, None
                 reason = redact(f"stopped on an error: {type(exc).__name__}: {exc}")
             finally:
                 events.catch_up(session.records, lag=0)
     finally:
         session.close()
-    _finish(session, todo, outputs, events.written, reason)
+    signum = signum if reason else None
+    _finish(session, todo, outputs, events.written, reason, signum)
     if failure is not None:
         raise failure
-    return RideOutputs(outputs.events, outputs.summary, outputs.figure, reason)
+    return RideOutputs(outputs.events, outputs.summary, outputs.figure, reason, signum)
 
 
 def _drive(
@@ -200,12 +269,14 @@ def _finish(
     outputs: RideOutputs,
     steps: int,
     reason: str | None,
+    signum: int | None,
 ) -> None:
     """Write the figure, then the summary (each under a temporary name first)."""
     summary = session.summary()
     summary["steps"] = steps
     summary["interrupted"] = reason is not None
     summary["interruption"] = reason
+    summary["signal"] = None if signum is None else signal.Signals(signum).name
     summary["unused_script_lines"] = [line.model_dump(mode="json") for line in todo]
     title = f"Ride: traffic {session.config.traffic_level:g}, seed {session.config.seed}"
     if reason is not None:

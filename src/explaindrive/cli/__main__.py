@@ -1,0 +1,5 @@
+"""``python -m explaindrive.cli``: the ``explaindrive`` program."""
+
+from explaindrive.cli.entry import main
+
+main()
