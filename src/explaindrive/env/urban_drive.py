@@ -247,9 +247,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             command=opts.command,
             schedule=schedule,
             start_pos_m=start_pos,
-            pedestrians=PedestrianSource(
-                int(sumo_seed), self.config.max_steps + 1.0, self.scenario.pedestrian_flows
-            ),
+            pedestrians=PedestrianSource(int(sumo_seed), self.scenario.pedestrian_flows),
             amber=AmberDecision(always=self.config.yellow_leader == "always"),
             noise=opts.noise if opts.noise is not None else self.config.noise,
             noise_rng=np.random.default_rng([int(sumo_seed), 17]),

@@ -1,12 +1,13 @@
 """Pedestrians: their demand, and the rule that keeps them off a crossing the ego is on.
 
 SUMO does not restore person flows from a saved state, so the environment adds
-pedestrians itself: Poisson arrivals per flow, drawn from a generator seeded
-with the episode seed (the same seed gives the same pedestrians).
+pedestrians itself: Poisson arrivals per flow, drawn as the ride goes from a generator
+seeded with the episode seed (the same seed gives the same pedestrians).
 """
 
 from __future__ import annotations
 
+import heapq
 from typing import Any
 
 import numpy as np
@@ -18,28 +19,26 @@ from explaindrive.sim.scenario.layout import PEDESTRIAN_FLOWS, PedestrianFlow
 class PedestrianSource:
     """Adds the pedestrians of :data:`PEDESTRIAN_FLOWS` to a running simulation.
 
+    Each flow is a Poisson process with a generator of its own, seeded with the episode seed
+    and the flow's index; the next arrival of a flow is drawn only once the previous one has
+    been added, so memory does not grow with the length of a ride.
+
     Args:
-        seed: seed of the arrival process.
-        horizon_s: arrivals are drawn for this many seconds.
+        seed: seed of the arrival processes.
         flows: the pedestrian flows (the scenario's by default).
     """
 
-    def __init__(
-        self, seed: int, horizon_s: float, flows: tuple[PedestrianFlow, ...] = PEDESTRIAN_FLOWS
-    ) -> None:
-        rng = np.random.default_rng(seed)
-        arrivals: list[tuple[float, int]] = []
-        for i, flow in enumerate(flows):
-            mean_gap_s = 3600.0 / flow.persons_per_hour
-            t = float(rng.exponential(mean_gap_s))
-            while t < horizon_s:
-                arrivals.append((t, i))
-                t += float(rng.exponential(mean_gap_s))
-        arrivals.sort()
-        self._arrivals = arrivals
+    def __init__(self, seed: int, flows: tuple[PedestrianFlow, ...] = PEDESTRIAN_FLOWS) -> None:
         self._flows = flows
-        self._next = 0
+        self._rngs = [np.random.default_rng([seed, i]) for i in range(len(flows))]
+        self._due: list[tuple[float, int]] = [
+            (self._gap(i), i) for i in range(len(flows)) if flows[i].persons_per_hour > 0
+        ]
+        heapq.heapify(self._due)
         self._count = 0
+
+    def _gap(self, flow: int) -> float:
+        return float(self._rngs[flow].exponential(3600.0 / self._flows[flow].persons_per_hour))
 
     @property
     def added(self) -> int:
@@ -48,13 +47,14 @@ class PedestrianSource:
 
     def step(self, api: Any, elapsed_s: float) -> None:
         """Add every pedestrian due by ``elapsed_s`` (seconds since the source started)."""
-        while self._next < len(self._arrivals) and self._arrivals[self._next][0] <= elapsed_s:
-            flow = self._flows[self._arrivals[self._next][1]]
+        while self._due and self._due[0][0] <= elapsed_s:
+            t, i = heapq.heappop(self._due)
+            flow = self._flows[i]
             pid = f"ped_{flow.id}_{self._count}"
             api.person.add(pid, flow.from_edge, flow.depart_pos_m, depart=-3)
             api.person.appendWalkingStage(pid, [flow.from_edge, flow.to_edge], flow.arrival_pos_m)
-            self._next += 1
             self._count += 1
+            heapq.heappush(self._due, (t + self._gap(i), i))
 
 
 class KerbYield:
