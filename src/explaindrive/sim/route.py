@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import bisect
 import itertools
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-SPEED_SIGN_LOOKAHEAD_M = 40.0  # [m] a lower limit ahead applies from this distance on
+POSTED_DECEL_MPS2 = 0.75  # [m/s^2] the posted limit ramps down to a lower zone at this rate
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,15 +64,27 @@ class RouteGeometry:
         i = bisect.bisect_right(self.zone_start_m, pos_m) - 1
         return self.zone_limit_mps[max(i, 0)]
 
-    def posted_limit(self, pos_m: float, lookahead_m: float = SPEED_SIGN_LOOKAHEAD_M) -> float:
-        """Limit the driver must respect at ``pos_m``: the lowest limit within ``lookahead_m``.
+    def posted_limit(self, pos_m: float, decel_mps2: float = POSTED_DECEL_MPS2) -> float:
+        """Limit the driver must respect at ``pos_m``: the legal limit, lowered before each
+        lower zone ``d`` metres ahead to the speed v from which braking at ``b`` =
+        ``decel_mps2`` still reaches the zone's limit at its start after this step's travel,
+        v^2 + 2 b v = v_zone^2 + 2 b d, and never below the zone's limit.
 
-        This models speed-limit signs that are visible before the zone starts, so a
-        lower limit ahead is known in time to brake for it.
+        This models speed-limit signs seen in time: a driver who keeps to the posted limit
+        slows down for a lower zone by at most 1 m/s per 1 s step and is within the zone's
+        limit once in it (``tests/sim/test_route.py`` drives it).
         """
-        lo = bisect.bisect_right(self.zone_start_m, pos_m) - 1
-        hi = bisect.bisect_right(self.zone_start_m, pos_m + lookahead_m)
-        return min(self.zone_limit_mps[max(lo, 0) : max(hi, 1)])
+        here = bisect.bisect_right(self.zone_start_m, pos_m) - 1
+        limit = self.zone_limit_mps[max(here, 0)]
+        for start, zone_limit in zip(
+            self.zone_start_m[here + 1 :], self.zone_limit_mps[here + 1 :], strict=True
+        ):
+            if zone_limit < limit:
+                b = decel_mps2
+                reach = zone_limit * zone_limit + 2.0 * b * (start - pos_m)
+                ramp = -b + math.sqrt(b * b + reach) if reach > 0.0 else 0.0
+                limit = min(limit, max(zone_limit, ramp))
+        return limit
 
 
 def _lane_lengths(root: ET.Element) -> dict[str, tuple[float, float]]:
