@@ -79,3 +79,16 @@ def test_linear_schedule() -> None:
     assert linear_schedule(1.0, 0.1, 100, 0) == pytest.approx(1.0)
     assert linear_schedule(1.0, 0.1, 100, 50) == pytest.approx(0.55)
     assert linear_schedule(1.0, 0.1, 100, 500) == pytest.approx(0.1)
+
+
+def test_the_unsafe_loss_with_a_margin_pushes_below_the_best_safe_action() -> None:
+    q = torch.tensor([[5.0, 3.0, 8.0, -9.0], [1.0, 2.0, 3.0, 4.0]])
+    mask = torch.tensor([[True, False, False, False], [False, False, False, False]])
+    # row 0: floor 5 - 10 = -5: excess 8, 13 and 0 -> 64 + 169 = 233
+    # row 1: no safe action, floor -100: excess 101..104 -> 10201 + 10404 + 10609 + 10816
+    loss = unsafe_action_loss(q, mask, unsafe_q=-100.0, margin=10.0)
+    assert float(loss) == pytest.approx((233 + 10201 + 10404 + 10609 + 10816) / 2)
+    # the floor is not differentiated: only the unsafe values get a gradient
+    q.requires_grad_(True)
+    unsafe_action_loss(q, mask, unsafe_q=-100.0, margin=10.0).backward()
+    assert q.grad is not None and float(q.grad[0, 0]) == 0.0

@@ -139,6 +139,9 @@ class TrainConfig(ConfigModel, ScenarioFields):
     """Value the Q-values of unsafe actions are pushed down to (``safe_learning``)."""
     unsafe_loss_weight: NonNegativeFloat = 1.0
     """Weight of that loss next to the TD loss."""
+    unsafe_margin: PositiveFloat | None = None
+    """If set, unsafe actions are pushed to this far below the best safe action of their
+    state instead of to ``unsafe_q`` (a large-margin loss; ``safe_learning``)."""
     yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = DEFAULT_YELLOW_LEADER
     """When the environment makes a yellow light's stop line a virtual leader: ``decided``
     once by whether the car can still stop there, or ``always`` (the paper; see
@@ -249,6 +252,7 @@ after that; training ends early once 200 episodes in a row needed no override.""
 
 PASSENGER = SAFE.replace(
     reward="passenger",
+    unsafe_margin=10.0,
     obs_noise_max=(3.0, 0.9),
     stop_when_safe=None,
 )

@@ -122,7 +122,9 @@ class D3QNLearner:
         unsafe = torch.zeros(())
         if c.safe_learning:
             mask = torch.from_numpy(batch.mask)
-            unsafe = unsafe_action_loss(q_obs, mask, c.unsafe_q, c.loss, c.huber_delta)
+            unsafe = unsafe_action_loss(
+                q_obs, mask, c.unsafe_q, c.loss, c.huber_delta, c.unsafe_margin
+            )
             loss = td + c.unsafe_loss_weight * unsafe
 
         self.optimizer.zero_grad(set_to_none=True)

@@ -64,12 +64,21 @@ def double_dqn_target(
 
 
 def unsafe_action_loss(
-    q_values: Tensor, mask: Tensor, unsafe_q: float, kind: str = "mse", huber_delta: float = 1.0
+    q_values: Tensor,
+    mask: Tensor,
+    unsafe_q: float,
+    kind: str = "mse",
+    huber_delta: float = 1.0,
+    margin: float | None = None,
 ) -> Tensor:
-    """Loss that pushes the Q-value of every unsafe action down to ``unsafe_q``.
+    """Loss that pushes the Q-value of every unsafe action down to ``unsafe_q``, or, with
+    ``margin``, to ``margin`` below the best safe action of its state.
 
-    Only values above ``unsafe_q`` are pushed; safe actions (``mask`` true) are untouched.
-    The per-state sum over unsafe actions is averaged over the batch.
+    Only values above that floor are pushed; safe actions (``mask`` true) are untouched.
+    The per-state sum over unsafe actions is averaged over the batch. The relative floor
+    (a large-margin loss, as in DQfD) keeps every unsafe action below every safe one without
+    dragging the values of a state towards a fixed number; a state without a safe action
+    falls back to ``unsafe_q``.
 
     Args:
         q_values: online Q-values, ``(B, n_actions)``.
@@ -77,8 +86,13 @@ def unsafe_action_loss(
         unsafe_q: the value unsafe actions are pushed to.
         kind: ``mse`` or ``huber``, as :func:`td_loss`.
         huber_delta: threshold of the Huber loss.
+        margin: if set, the floor is the best safe Q-value (not differentiated) minus this.
     """
-    excess = (q_values - unsafe_q).clamp(min=0.0) * (~mask).to(q_values.dtype)
+    floor = torch.full_like(q_values[:, :1], unsafe_q)
+    if margin is not None:
+        best_safe = q_values.detach().masked_fill(~mask, -torch.inf).max(dim=-1, keepdim=True)
+        floor = torch.where(torch.isfinite(best_safe.values), best_safe.values - margin, floor)
+    excess = (q_values - floor).clamp(min=0.0) * (~mask).to(q_values.dtype)
     if kind == "mse":
         per_action = excess.square()
     elif kind == "huber":
