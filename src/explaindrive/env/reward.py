@@ -126,7 +126,7 @@ PASSENGER_RECIPE = RewardRecipe(
         time=0.5,
         jerk=1.0,
         hard_brake=1.0,
-        approach=1.0,
+        approach=0.5,
         signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
     ),
