@@ -41,7 +41,7 @@ def test_bad_policy_files_name_the_file(tmp_path: Path) -> None:
         load_policy(path)
     assert str(path.with_suffix(".json")) in str(err.value)
     path.write_bytes(b"\x00garbage")
-    with pytest.raises(CheckpointError, match="corrupt") as err:
+    with pytest.raises(CheckpointError, match="is not an explaindrive policy file") as err:
         load_policy(path)
     assert str(path) in str(err.value)
     with pytest.raises(CheckpointError, match="not found"):
