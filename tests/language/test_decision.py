@@ -8,7 +8,12 @@ import pytest
 
 from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
 from explaindrive.language.decision import Conflict, Factor, parse_decision_tag, rule_decision
-from explaindrive.language.explanation import check_grounding, mentioned_factors, present_factors
+from explaindrive.language.explanation import (
+    check_grounding,
+    mentioned_factors,
+    present_factors,
+    template_explanation,
+)
 from explaindrive.language.grounding import reply_problems, wording_problems
 from explaindrive.language.hazards import braking_hazards
 from explaindrive.language.summary import StateRecord
@@ -84,7 +89,11 @@ def test_explainer_distances_and_colour() -> None:
     e = TemplateExplainer().explain(r, d.factor)
     assert "35 m" in e.text and "yellow" in e.text
     with pytest.raises(ValueError, match="not in the state"):
-        TemplateExplainer().explain(r, Factor.PEDESTRIAN)
+        template_explanation(r, Factor.PEDESTRIAN)
+    # the explainer never raises: a factor the state lacks gives a sentence naming none
+    n = TemplateExplainer().explain(r, Factor.PEDESTRIAN)
+    assert n.factor is None and mentioned_factors(n.text) == set()
+    assert n.text.startswith(("I'm braking", "I'm slowing us down firmly", "I had to brake"))
 
 
 def test_grounding_flags_absent_factor() -> None:
@@ -184,6 +193,4 @@ def test_acceleration_through_a_yellow_light_is_explained_truly(action: int) -> 
     assert "15 m" in text and "yellow" in text
     assert reply_problems(text, r, Factor.TRAFFIC_LIGHT) == []
     with pytest.raises(ValueError, match="cannot be explained"):
-        TemplateExplainer().explain(
-            rec("comfort", 2, d_tl=15.0, tl_state="red"), Factor.TRAFFIC_LIGHT
-        )
+        template_explanation(rec("comfort", 2, d_tl=15.0, tl_state="red"), Factor.TRAFFIC_LIGHT)

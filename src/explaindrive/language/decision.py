@@ -81,6 +81,9 @@ class Decision:
         backend: backend that answered; ``fallback`` when ``embedded`` stood in.
         latency_s: wall time of the call [s].
         error: why the configured backend was bypassed, when ``fallback``.
+        vetoed: a remote ``[EXPLAIN]`` was overruled because the state holds no conflict
+            with the request or no safety factor to name.
+        raw_reply: the remote model's reply as it came (for the ride log only).
     """
 
     explain: bool
@@ -91,6 +94,8 @@ class Decision:
     fallback: bool = False
     latency_s: float = 0.0
     error: str | None = None
+    vetoed: bool = False
+    raw_reply: str | None = None
 
     @property
     def tag(self) -> str:

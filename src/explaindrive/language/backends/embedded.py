@@ -10,7 +10,12 @@ from explaindrive.language.config import EmbeddedConfig
 from explaindrive.language.corrections import last_instruction
 from explaindrive.language.datasets import INTENT_LABELS
 from explaindrive.language.decision import Decision, ExplanationDecider, Factor, rule_decision
-from explaindrive.language.explanation import Explainer, Explanation, template_explanation
+from explaindrive.language.explanation import (
+    Explainer,
+    Explanation,
+    neutral_explanation,
+    template_explanation,
+)
 from explaindrive.language.features import SentenceEncoder, features
 from explaindrive.language.intent import (
     REPHRASE_MESSAGE,
@@ -112,13 +117,17 @@ class TemplateExplainer(Explainer):
     def explain(self, record: StateRecord, factor: Factor | None) -> Explanation:
         """Explain ``record``'s action by ``factor`` (by the rule engine's pick when ``None``).
 
-        Raises:
-            ValueError: if no factor is given and the state holds no safety reason.
+        When the state holds no safety reason, or ``factor`` cannot explain the action,
+        the explanation names no factor (:func:`neutral_explanation`). Never raises.
         """
         t0 = time.perf_counter()
         if factor is None:
             factor = rule_decision(record, self.config.cutoff_m).factor
+        try:
             if factor is None:
-                raise ValueError("nothing to explain: no safety factor in the state")
-        text = template_explanation(record, factor, self.config.cutoff_m)
+                raise ValueError("no safety factor in the state")
+            text = template_explanation(record, factor, self.config.cutoff_m)
+        except ValueError as exc:
+            log.info("no grounded explanation (%s); a neutral one is given", exc)
+            text, factor = neutral_explanation(record), None
         return Explanation(text, factor, NAME, latency_s=time.perf_counter() - t0)

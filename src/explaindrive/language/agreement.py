@@ -1,0 +1,71 @@
+"""When the remote model and the embedded interpreter read a line differently.
+
+With the ``openai`` backend every line is read twice: by the embedded interpreter
+(first, offline, with class probabilities) and by the remote model. The policy, one
+rule per case, in the order they are tried:
+
+1. ``stop-local``: the embedded reading is STOP. It is answered at once; the remote
+   model is not asked (the STOP lane).
+2. ``stop-remote``: the remote reading is STOP. A STOP from either reader wins; the
+   passenger is still asked to confirm it.
+3. ``agree``: both readings are the same (a command, or not a driving request).
+4. ``local-sure-none``: the embedded reading is "not a request" with probability at least
+   :data:`SURE_P`. The remote command does not turn it into a driving change.
+5. ``local-sure``: the embedded reading is a command with probability at least
+   :data:`SURE_P`; it stands against a different remote command or a remote "not a
+   request".
+6. ``remote-none``: the remote model says the line is not a driving request and the
+   embedded reading is an unsure command: no command, the passenger is asked to
+   rephrase.
+7. ``remote``: otherwise (the embedded reading is unsure) the remote command is taken.
+
+Only a well-formed remote reply takes part; a malformed one, an error or a call past its
+deadline leaves the embedded reading alone (a fallback, counted as such).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from explaindrive.commands import Command
+
+SURE_P = 0.8  # the embedded reading's probability from which it is not overridden
+
+
+@dataclass(frozen=True, slots=True)
+class Verdict:
+    """The reading that counts and the rule that chose it.
+
+    Attributes:
+        intent: the command, or ``None`` (not a driving request).
+        source: ``embedded``, ``openai`` or ``both`` (the readings agree).
+        rule: the name of the policy's rule that decided (see the module docstring).
+    """
+
+    intent: Command | None
+    source: str
+    rule: str
+
+
+def reconcile(
+    local: Command | None,
+    local_p: float,
+    remote: Command | None,
+    remote_name: str = "openai",
+) -> Verdict:
+    """Decide between the embedded reading ``local`` (with its probability ``local_p``)
+    and the remote reading ``remote`` (``None``: "not a driving request")."""
+    if local is Command.STOP:
+        return Verdict(Command.STOP, "embedded", "stop-local")
+    if remote is Command.STOP:
+        return Verdict(Command.STOP, remote_name, "stop-remote")
+    if local == remote:
+        return Verdict(local, "both", "agree")
+    sure = local_p >= SURE_P
+    if local is None and sure:
+        return Verdict(None, "embedded", "local-sure-none")
+    if local is not None and sure:
+        return Verdict(local, "embedded", "local-sure")
+    if remote is None:
+        return Verdict(None, remote_name, "remote-none")
+    return Verdict(remote, remote_name, "remote")
