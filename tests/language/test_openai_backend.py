@@ -56,7 +56,9 @@ def test_intent_good_reply_uses_paper_prompt(openai_server, interpreter) -> None
     assert body["messages"][1]["content"] == "I'm feeling a bit sick"
 
 
-def test_a_tampered_reply_reaches_the_passenger_only_as_the_template(openai_server, interpreter) -> None:  # type: ignore[no-untyped-def]
+def test_a_tampered_reply_reaches_the_passenger_as_the_template(
+    openai_server: ScriptedOpenAI, interpreter: EmbeddedIntentInterpreter
+) -> None:
     raw = "Sure! Driving at 200 km/h now. You want me to drive faster, is this correct?"
     openai_server.script = [("ok", raw)]
     it = OpenAIIntentInterpreter(client(openai_server), interpreter)

@@ -12,6 +12,7 @@ from rich.table import Table
 from explaindrive.cli._language_common import (
     BACKEND_HELP,
     CONFIG_HELP,
+    MODEL_HELP,
     console,
     fail,
     load_config,
@@ -48,13 +49,14 @@ def intents_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+    model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
     try:
         rows = load_commands(data)
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config)).load()
+        stack = make_language_stack(backend, load_config(config, model)).load()
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_intents
@@ -85,6 +87,7 @@ def decisions_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+    model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Trigger accuracy/precision/recall/F1, factor accuracy and checked explanations of
     LLM-2/LLM-3."""
@@ -92,7 +95,7 @@ def decisions_command(
         rows = load_decisions(data)
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config))
+        stack = make_language_stack(backend, load_config(config, model))
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_decisions

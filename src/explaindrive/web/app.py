@@ -34,6 +34,7 @@ from starlette.datastructures import UploadFile
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from explaindrive.language.backends import check_backend
+from explaindrive.language.config import LanguageConfig
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.sim.scenario.files import default_scenario
@@ -78,6 +79,8 @@ class RealStack:
         fast_policy: a fast network in place of the shipped one (a policy ``.pt`` file or
             a training run directory).
         comfort_policy: likewise for the comfort network.
+        language: the language layer's configuration (endpoint, model...); ``None`` =
+            the defaults.
     """
 
     def __init__(
@@ -85,23 +88,24 @@ class RealStack:
         backend: str = "embedded",
         fast_policy: Path | None = None,
         comfort_policy: Path | None = None,
+        language: LanguageConfig | None = None,
     ) -> None:
         self.backend = check_backend(backend)
         self.policies = (fast_policy, comfort_policy)
+        self.language_config = language or LanguageConfig()
         self._controller: Any = None
         self._language: Any = None
 
     def __call__(self, config: RideConfig) -> RideSession:
         """Build a ride session with ``config`` (its backend is replaced by this one's)."""
         from explaindrive.agent.controller import MergedController
-        from explaindrive.language.config import LanguageConfig
         from explaindrive.language.stack import make_language_stack
 
         fast, comfort = self.policies
         if self._controller is None:
             self._controller = MergedController.from_package(fast=fast, comfort=comfort)
         if self._language is None:
-            self._language = make_language_stack(self.backend, LanguageConfig()).load()
+            self._language = make_language_stack(self.backend, self.language_config).load()
         config = config.replace(backend=self.backend, fast_policy=fast, comfort_policy=comfort)
         return RideSession(config, self._controller, self._language)
 
