@@ -29,6 +29,7 @@ from explaindrive.language.hazards import (
     SHORT_TTC_S,
     Factor,
     braking_hazards,
+    leader_explains_firm_braking,
     leader_is_hazard,
     stopping_distance_m,
 )
@@ -167,6 +168,12 @@ def rule_decision(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> De
     factors = (
         acceleration_factors(s) if conflict is Conflict.HARSH_ACCELERATION else braking_factors(s)
     )
+    if (
+        conflict is Conflict.SLOWS
+        and Factor.LEAD_VEHICLE not in factors
+        and leader_explains_firm_braking(s, record.action)
+    ):
+        factors.append(Factor.LEAD_VEHICLE)  # firm braking for a leader not yet close
     if not factors:
         return Decision(
             False,
