@@ -14,9 +14,11 @@ def test_stop_local_wins_whatever_the_remote_says() -> None:
     assert reconcile(STOP, 0.31, None) == Verdict(STOP, "embedded", "stop-local")
 
 
-def test_stop_remote_wins_even_against_a_sure_reading() -> None:
-    assert reconcile(FAST, 0.99, STOP) == Verdict(STOP, "openai", "stop-remote")
-    assert reconcile(None, 0.99, STOP) == Verdict(STOP, "openai", "stop-remote")
+def test_stop_remote_wins_over_an_unsure_reading_only() -> None:
+    assert reconcile(FAST, UNSURE, STOP) == Verdict(STOP, "openai", "stop-remote")
+    assert reconcile(None, UNSURE, STOP) == Verdict(STOP, "openai", "stop-remote")
+    assert reconcile(FAST, 0.975, STOP) == Verdict(FAST, "embedded", "local-sure")
+    assert reconcile(None, SURE, STOP) == Verdict(None, "embedded", "local-sure-none")
 
 
 def test_agreement() -> None:

@@ -98,13 +98,17 @@ def test_off_topic_answer_and_a_sure_none(
     assert (r.intent, r.rule, r.overruled) == (None, "local-sure-none", True)
 
 
-def test_a_remote_stop_wins(
+def test_a_remote_stop_wins_over_an_unsure_reading_only(
     openai_server: ScriptedOpenAI, interpreter: EmbeddedIntentInterpreter
 ) -> None:
+    it = OpenAIIntentInterpreter(client(openai_server), interpreter)
     openai_server.script = [("ok", "Sure. Shall I pull over here?")]
-    r = OpenAIIntentInterpreter(client(openai_server), interpreter).interpret(SICK)
+    unsure = "My friend lives around here somewhere."  # embedded: none at 0.74
+    r = it.interpret(unsure)
     assert (r.intent, r.rule) == (Command.STOP, "stop-remote")
     assert r.confirmation == "You want me to stop, is this correct?"
+    r = it.interpret(SICK)  # embedded: comfort at 0.99
+    assert (r.intent, r.rule, r.overruled) == (Command.COMFORT, "local-sure", True)
 
 
 @pytest.mark.parametrize(

@@ -77,6 +77,13 @@ def intents_command(
         f"none rejected {report['none_rejection']}  (n={report['n_commands']} + "
         f"{report['n_none']} none; fallbacks {report['fallbacks']})"
     )
+    replies = report["replies"]
+    console.print(
+        f"remote replies: accepted {replies['accepted']}, fell back {replies['fallback']}, "
+        f"vetoed {replies['vetoed']}, not asked {replies['not_asked']}  "
+        f"negated stops read as STOP {report['negated_stops_read_as_stop']}",
+        highlight=False,
+    )
     _write(out, report)
 
 
@@ -108,7 +115,7 @@ def decisions_command(
         f"F1 {report['f1']:.3f}  factor accuracy {report['factor_accuracy']} "
         f"(with several objects: {report['factor_accuracy_multi']}, n={report['n_multi']})  "
         f"grounded {report['grounded_share']}  true to the state {report['truthful_share']}  "
-        f"fallbacks {report['fallbacks']}"
+        f"fallbacks {report['fallbacks']}  vetoed {report['vetoed']}"
     )
     _write(out, report)
 
