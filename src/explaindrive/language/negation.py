@@ -26,8 +26,14 @@ _STOP_ACT = (
     r"|drop(?:ping)? (?:me|us)(?: off)?|let(?:ting)? (?:me|us) (?:out|off)"
     r"|get(?:ting)? (?:out|off)|hop(?:ping)? (?:out|off)|brak(?:e|ing))"
 )
+# words that may stand between the negation and the verb: "don't you dare stop", "I never
+# asked you to stop", "no need to pull over"
+_GAP = (
+    r"(?:just|even|really|need|needs|want|wanna|gonna|going|got|have|has|to|be|you|me|us"
+    r"|yet|ever|dare|say|said|ask|asked|tell|told|plan|planning|mean|meant)"
+)
 _NEGATED = (
-    re.compile(rf"(?<!why )(?<!why you )\b{_NEG}\s+(?:[\w']+\s+){{0,3}}?{_STOP_ACT}\b", _I),
+    re.compile(rf"(?<!why )(?<!why you )\b{_NEG}\s+(?:{_GAP}\s+){{0,3}}{_STOP_ACT}\b", _I),
     re.compile(r"\b(?:isn'?t|is not|not|wasn'?t)\s+(?:my|our|the right|the)\s+stop\b", _I),
     re.compile(
         r"\bnot (?:here|this (?:one|corner|street|spot|block))\b(?=.*\b(?:keep|carry on|drive on"
@@ -38,8 +44,8 @@ _NEGATED = (
 _COMPLAINT = (
     re.compile(
         r"\b(?:another|yet another|every(?: single)?|all (?:these|those|the)|so many|each)\s+"
-        r"(?:[\w-]+\s+){0,2}?(?:red lights?|lights?|traffic lights?|signals?|stops?|junctions?"
-        r"|stop-and-go|sudden stops?)\b",
+        r"(?:(?:single|bloody|damn|stupid|sudden|red|traffic|of these|of the)\s+){0,2}"
+        r"(?:lights?|signals?|stops?|junctions?|stop-and-go)\b",
         _I,
     ),
     re.compile(r"\b(?:red|stopped|stopping|stop)\s+(?:light\s+)?again\b", _I),

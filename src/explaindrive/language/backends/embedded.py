@@ -24,11 +24,13 @@ from explaindrive.language.intent import (
     format_confirmation,
 )
 from explaindrive.language.intent_classifier import IntentClassifier
+from explaindrive.language.negation import stop_is_ruled_out
 from explaindrive.language.summary import StateRecord
 
 log = logging.getLogger(__name__)
 
 NAME = "embedded"
+_STOP = INTENT_LABELS.index("stop")
 
 
 class EmbeddedIntentInterpreter(IntentInterpreter):
@@ -57,7 +59,9 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
 
         A request that corrects itself is read by its last instruction: the part after
         its last repair marker (:func:`~explaindrive.language.corrections.last_instruction`)
-        decides whenever it asks for a command on its own.
+        decides whenever it asks for a command on its own. A line that mentions stopping
+        only negated or in a complaint
+        (:func:`~explaindrive.language.negation.stop_is_ruled_out`) is not read as STOP.
         """
         t0 = time.perf_counter()
         if not text or not text.strip():
@@ -65,6 +69,10 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         last = last_instruction(text)
         texts = [text] if last is None else [text, last]
         p = self.classifier.proba(features(self.encoder, texts, self.classifier.spec))
+        for i, t in enumerate(texts):  # "don't stop here", "another red light": not STOP
+            if stop_is_ruled_out(t):
+                p[i, _STOP] = 0.0
+                p[i] /= max(float(p[i].sum()), 1e-12)
         labels = [
             self.classifier.decide(row, self.config.stop_threshold, self.config.none_margin)
             for row in p
