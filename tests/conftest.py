@@ -17,7 +17,7 @@ MODEL_MODULES = frozenset({
     "tests/ride/test_ride_shipped.py", "tests/ride/test_stop_lane.py",
     "tests/language/test_cli.py", "tests/language/test_shipped_models.py",
     "tests/language/test_onnx_encoder.py", "tests/language/test_openai_backend.py",
-    "tests/web/test_uploads.py",
+    "tests/web/test_uploads.py", "tests/ride/test_ride_model_choice.py",
 })  # fmt: skip
 
 

@@ -56,6 +56,8 @@ def test_interpret_json_and_bad_backend(interpreter) -> None:  # type: ignore[no
         "fallback": False,
         "instruction": None,
         "stop_lane": False,
+        "rule": None,
+        "overruled": False,
         "error": None,
     }
     res = runner.invoke(app, ["interpret", "hi", "--backend", "gpt9"])

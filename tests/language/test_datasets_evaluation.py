@@ -10,6 +10,7 @@ import pytest
 from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.datasets import (
+    BLIND_CSV,
     DECISIONS_JSONL,
     RESERVE_SPLIT,
     TEST_CSV,
@@ -60,6 +61,24 @@ def test_blind_test_file() -> None:
     near_copies = [
         (t.text, s)
         for t in test
+        for s in seen
+        if SequenceMatcher(None, t.text.lower(), s).quick_ratio() >= NEAR_COPY
+        and SequenceMatcher(None, t.text.lower(), s).ratio() >= NEAR_COPY
+    ]
+    assert near_copies == []
+
+
+def test_second_blind_test_file() -> None:
+    blind = load_commands(data_path(BLIND_CSV))
+    by_label = Counter(r.label for r in blind)
+    assert len(blind) == 167 and by_label == {"fast": 46, "comfort": 47, "stop": 33, "none": 41}
+    by_kind = Counter(r.kind for r in blind)
+    assert by_kind["negated_stop"] == 18 and by_kind["offtopic"] == 40
+    assert {r.label for r in blind if r.kind == "negated_stop"} == {"fast", "comfort"}
+    seen = _texts(load_commands(data_path(TRAIN_CSV))) | _texts(load_commands(data_path(TEST_CSV)))
+    near_copies = [
+        (t.text, s)
+        for t in blind
         for s in seen
         if SequenceMatcher(None, t.text.lower(), s).quick_ratio() >= NEAR_COPY
         and SequenceMatcher(None, t.text.lower(), s).ratio() >= NEAR_COPY

@@ -8,7 +8,12 @@ import pytest
 
 from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
 from explaindrive.language.decision import Conflict, Factor, parse_decision_tag, rule_decision
-from explaindrive.language.explanation import check_grounding, mentioned_factors, present_factors
+from explaindrive.language.explanation import (
+    check_grounding,
+    mentioned_factors,
+    present_factors,
+    template_explanation,
+)
 from explaindrive.language.grounding import reply_problems, wording_problems
 from explaindrive.language.hazards import braking_hazards
 from explaindrive.language.summary import StateRecord
@@ -84,7 +89,11 @@ def test_explainer_distances_and_colour() -> None:
     e = TemplateExplainer().explain(r, d.factor)
     assert "35 m" in e.text and "yellow" in e.text
     with pytest.raises(ValueError, match="not in the state"):
-        TemplateExplainer().explain(r, Factor.PEDESTRIAN)
+        template_explanation(r, Factor.PEDESTRIAN)
+    # the explainer never raises: a factor the state lacks gives a sentence naming none
+    n = TemplateExplainer().explain(r, Factor.PEDESTRIAN)
+    assert n.factor is None and mentioned_factors(n.text) == set()
+    assert n.text.startswith(("I'm braking", "I'm slowing us down firmly", "I had to brake"))
 
 
 def test_grounding_flags_absent_factor() -> None:
@@ -184,6 +193,50 @@ def test_acceleration_through_a_yellow_light_is_explained_truly(action: int) -> 
     assert "15 m" in text and "yellow" in text
     assert reply_problems(text, r, Factor.TRAFFIC_LIGHT) == []
     with pytest.raises(ValueError, match="cannot be explained"):
-        TemplateExplainer().explain(
-            rec("comfort", 2, d_tl=15.0, tl_state="red"), Factor.TRAFFIC_LIGHT
-        )
+        template_explanation(rec("comfort", 2, d_tl=15.0, tl_state="red"), Factor.TRAFFIC_LIGHT)
+
+
+@pytest.mark.parametrize("action", [-1, -2, -3])
+def test_a_standing_car_is_never_said_to_brake(action: int) -> None:
+    r = rec("fast", action, v_ego=0.0, d_tl=5.0, tl_state="red")
+    text = TemplateExplainer().explain(r, Factor.TRAFFIC_LIGHT).text
+    assert text.startswith(("We're waiting here", "I'm keeping us stopped", "We're staying put")), (
+        text
+    )
+    assert reply_problems(text, r, Factor.TRAFFIC_LIGHT) == []
+    said = wording_problems("I'm reducing our speed a little for the red light.", r)
+    assert f"says slowing down while the action is {action:+d} m/s at 0.0 m/s" in said
+
+
+@pytest.mark.parametrize(
+    ("v_ego", "action", "kind"),
+    [(0.0, 0, "wait"), (0.3, -3, "wait"), (8.0, 0, "hold"), (8.0, -1, "gentle_brake"),
+     (8.0, -3, "hard_brake"), (2.0, -3, "stopping"), (0.0, 2, "accelerate")],
+)  # fmt: skip
+def test_the_opener_follows_speed_and_action(v_ego: float, action: int, kind: str) -> None:
+    from explaindrive.language.explanation import opener_kind
+
+    assert opener_kind(rec("fast", action, v_ego=v_ego)) == kind
+
+
+@pytest.mark.parametrize(
+    ("v_ego", "d_lead", "dv", "action", "explained"),
+    [
+        (13.0, 40.0, 3.0, -3, True),  # closing: explained by the leader
+        (13.0, 48.0, 1.0, -2, True),
+        (13.0, 45.0, 0.0, -3, True),  # headway 45 / 13 = 3.5 s < 4 s
+        (10.0, 45.0, -1.0, -3, False),  # pulling away, headway 4.5 s
+        (13.0, 56.0, 3.0, -3, False),  # beyond the 50 m cut-off
+        (13.0, 40.0, 3.0, -1, False),  # gentle braking needs no leader to explain it
+    ],
+)
+def test_firm_braking_behind_a_leader_under_fast(
+    v_ego: float, d_lead: float, dv: float, action: int, explained: bool
+) -> None:
+    r = rec("fast", action, v_ego=v_ego, v_lim=13.9, d_lead=d_lead, dv=dv)
+    d = RuleDecider().decide(r)
+    assert d.explain is explained
+    if explained:
+        assert d.factor is Factor.LEAD_VEHICLE
+        text = TemplateExplainer().explain(r, d.factor).text
+        assert f"{d_lead:.0f} m" in text and reply_problems(text, r, d.factor) == []

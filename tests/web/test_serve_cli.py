@@ -61,3 +61,39 @@ def test_a_trained_network_reaches_the_rides(
     assert res.exit_code == 0, res.output
     stack = served["app"].state.manager.session_factory  # type: ignore[attr-defined]
     assert isinstance(stack, RealStack) and stack.policies == (run, None)
+
+
+def test_the_configured_model_reaches_the_endpoint(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    from explaindrive.language.stack import make_language_stack
+    from explaindrive.language.summary import StateRecord
+    from explaindrive.web import server as web_server
+    from explaindrive.web.app import RealStack
+    from tests.language.conftest import ScriptedOpenAI
+
+    server = ScriptedOpenAI()
+    try:
+        config = tmp_path / "local.yaml"
+        config.write_text(f"backend: openai\nopenai: {{base_url: {server.base_url}}}\n")
+        served: dict[str, object] = {}
+        monkeypatch.setattr(
+            web_server, "run_server", lambda app, host, port: served.update(app=app, host=host)
+        )
+        res = runner.invoke(app, ["serve", "--config", str(config), "--model", "smollm2"])
+        assert res.exit_code == 0, res.output
+        stack = served["app"].state.manager.session_factory  # type: ignore[attr-defined]
+        assert isinstance(stack, RealStack) and stack.backend == "openai"
+        language = make_language_stack(stack.backend, stack.language_config)
+        rec = StateRecord.model_validate(
+            {"request": "fast", "action": -2, "state": {"v_ego": 9.0, "v_lim": 13.9}}
+        )
+        language.decider.decide(rec)
+        assert [b["model"] for b in server.requests] == ["smollm2"]
+    finally:
+        server.close()
+
+
+def test_a_missing_language_config_exits_before_serving(tmp_path: Path) -> None:
+    res = runner.invoke(app, ["serve", "--config", str(tmp_path / "none.yaml")])
+    assert res.exit_code == 2 and "language config not found" in res.output

@@ -16,13 +16,26 @@ console = Console()
 err_console = Console(stderr=True)
 
 BACKEND_HELP = "Language backend: embedded (offline, default) or openai."
-CONFIG_HELP = "YAML language config (see docs/language.md)."
+CONFIG_HELP = "YAML language config: backend, endpoint, model, key variable, timeouts."
+MODEL_HELP = "Model name for the openai backend (replaces openai.model of --config)."
 
 
-def load_config(path: Path | None) -> LanguageConfig:
-    """The language config from ``path`` or the defaults; exits with a message on errors."""
+def read_config(path: Path | None, model: str | None = None) -> LanguageConfig:
+    """The language config from ``path`` (or the defaults) with ``model`` as the remote
+    model when given.
+
+    Raises:
+        FileNotFoundError: if ``path`` does not exist.
+        ValueError: if the file is malformed, or ``model`` is empty.
+    """
+    config = LanguageConfig() if path is None else LanguageConfig.from_yaml(path)
+    return config.with_model(model)
+
+
+def load_config(path: Path | None, model: str | None = None) -> LanguageConfig:
+    """:func:`read_config`, exiting with one line and status 2 on errors."""
     try:
-        return LanguageConfig() if path is None else LanguageConfig.from_yaml(path)
+        return read_config(path, model)
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
 

@@ -13,6 +13,7 @@ import typer
 from explaindrive.cli._language_common import (
     BACKEND_HELP,
     CONFIG_HELP,
+    MODEL_HELP,
     console,
     emit_json,
     fail,
@@ -26,30 +27,29 @@ def explain_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+    model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Decide whether a step's action needs explaining and, if so, explain it."""
     try:
         record = read_case(case)
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config))
+        stack = make_language_stack(backend, load_config(config, model))
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
-    decision = stack.decider.decide(record)
-    text = None
-    fallback = decision.fallback
-    errors = [decision.error] if decision.error else []
-    if decision.explain:
-        explanation = stack.explainer.explain(record, decision.factor)
-        text = explanation.text
-        fallback = fallback or explanation.fallback
-        errors += [explanation.error] if explanation.error else []
+    try:  # the modules answer every reply; a failure anywhere is one line, not a traceback
+        decision = stack.decider.decide(record)
+        explanation = stack.explainer.explain(record, decision.factor) if decision.explain else None
+    except Exception as exc:
+        fail(f"could not decide or explain {case}: {type(exc).__name__}: {exc}", code=1)
+    errors = [e.error for e in (decision, explanation) if e is not None and e.error]
     out = {
         "explain": decision.explain,
         "factor": decision.factor.value if decision.factor else None,
-        "text": text,
+        "text": explanation.text if explanation is not None else None,
         "backend": stack.backend,
-        "fallback": fallback,
+        "fallback": decision.fallback or (explanation is not None and explanation.fallback),
+        "vetoed": decision.vetoed,  # a remote [EXPLAIN] the state does not bear out
         "errors": errors,  # why the remote model was bypassed (a rejected reply says why)
     }
     if as_json:
@@ -57,8 +57,8 @@ def explain_command(
         return
     console.print(f"[dim]{environment_summary(record)}[/]", highlight=False)
     console.print(f"[bold]{decision.tag}[/] ({decision.reason})", highlight=False)
-    if text:
-        console.print(text, highlight=False)
+    if explanation is not None:
+        console.print(explanation.text, highlight=False)
 
 
 def read_case(path: Path) -> StateRecord:

@@ -10,6 +10,7 @@ import typer
 from explaindrive.cli._language_common import (
     BACKEND_HELP,
     CONFIG_HELP,
+    MODEL_HELP,
     console,
     emit_json,
     fail,
@@ -24,6 +25,7 @@ def interpret_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+    model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Map a passenger request (text or --audio) to fast, comfort, stop or no command."""
     if (text is None) == (audio is None):
@@ -31,7 +33,7 @@ def interpret_command(
     try:
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config)).load()
+        stack = make_language_stack(backend, load_config(config, model)).load()
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     transcript = None

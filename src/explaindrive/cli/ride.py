@@ -31,6 +31,7 @@ from rich.live import Live
 from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
+from explaindrive.cli._language_common import read_config
 from explaindrive.cli._signals import HANDLED_SIGNALS, exit_status, handle_signals, signal_label
 from explaindrive.language.config import LanguageConfig
 from explaindrive.limits import MAX_SEED
@@ -76,7 +77,22 @@ StopWithoutConfirmOption = Annotated[
 ]
 # The language modules
 BackendOption = Annotated[
-    str, typer.Option("--backend", help="Language backend: embedded or openai.")
+    str | None,
+    typer.Option("--backend", help="Language backend: embedded or openai (default: --config's)."),
+]
+LanguageConfigOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--config",
+        help="YAML language config: backend, endpoint, model, key variable, timeouts. "
+        "A local server: 'backend: openai' and 'openai: {base_url: "
+        "http://127.0.0.1:8080/v1, model: smollm2, timeout_s: 0.8}', then "
+        "explaindrive ride --config local.yaml (docs/language.md).",
+    ),
+]
+ModelOption = Annotated[
+    str | None,
+    typer.Option("--model", help="Model name for the openai backend (replaces --config's)."),
 ]
 CooldownOption = Annotated[float, typer.Option("--cooldown", help="Explanation cool-down [s].")]
 # The simulation
@@ -111,7 +127,7 @@ def ride(
     script: ScriptOption = None,
     interactive: InteractiveOption = False,
     voice: VoiceOption = False,
-    backend: BackendOption = "embedded",
+    backend: BackendOption = None,
     traffic: TrafficOption = 1.0,
     seed: SeedOption = 0,
     gui: GuiOption = False,
@@ -130,16 +146,19 @@ def ride(
     net: where.NetOption = None,
     route: where.RouteOption = None,
     demand: where.DemandOption = None,
+    language: LanguageConfigOption = None,
+    model: ModelOption = None,
 ) -> None:
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
     if voice and not interactive:
         _refuse("--voice needs --interactive")
     try:
+        language_config = read_config(language, model)
         config = RideConfig(
             traffic_level=traffic,
             seed=seed,
             max_steps=max_steps,
-            backend=backend,
+            backend=backend or language_config.backend,
             auto_confirm=auto_confirm,
             stop_without_confirm=stop_without_confirm,
             explanation_cooldown_s=cooldown,
@@ -150,10 +169,9 @@ def ride(
             obs_noise=_noise(obs_noise),
             **where.scenario_fields(scenario, net, route, demand),
         )
-        language_config = LanguageConfig()
         lines = _script_lines(script, interactive, max_steps)
         staging = prepare_out_dir(out, force)
-    except (ValueError, ScriptError, OutputDirError) as exc:
+    except (FileNotFoundError, ValueError, ScriptError, OutputDirError) as exc:
         _refuse(exc)
     session = _build_session(config, language_config, lines, speech=voice)
     typed = _passenger_input(voice) if interactive else None

@@ -12,6 +12,7 @@ from rich.table import Table
 from explaindrive.cli._language_common import (
     BACKEND_HELP,
     CONFIG_HELP,
+    MODEL_HELP,
     console,
     fail,
     load_config,
@@ -49,6 +50,7 @@ def intents_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+    model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
     refuse_bad_outputs(files=((out, "--json"),))
@@ -56,7 +58,7 @@ def intents_command(
         rows = load_commands(data)
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config)).load()
+        stack = make_language_stack(backend, load_config(config, model)).load()
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_intents
@@ -77,6 +79,13 @@ def intents_command(
         f"none rejected {report['none_rejection']}  (n={report['n_commands']} + "
         f"{report['n_none']} none; fallbacks {report['fallbacks']})"
     )
+    replies = report["replies"]
+    console.print(
+        f"remote replies: accepted {replies['accepted']}, fell back {replies['fallback']}, "
+        f"vetoed {replies['vetoed']}, not asked {replies['not_asked']}  "
+        f"negated stops read as STOP {report['negated_stops_read_as_stop']}",
+        highlight=False,
+    )
     _write(out, report)
 
 
@@ -87,6 +96,7 @@ def decisions_command(
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+    model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Trigger accuracy/precision/recall/F1, factor accuracy and checked explanations of
     LLM-2/LLM-3."""
@@ -95,7 +105,7 @@ def decisions_command(
         rows = load_decisions(data)
         from explaindrive.language.stack import make_language_stack
 
-        stack = make_language_stack(backend, load_config(config))
+        stack = make_language_stack(backend, load_config(config, model))
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_decisions
@@ -108,7 +118,7 @@ def decisions_command(
         f"F1 {report['f1']:.3f}  factor accuracy {report['factor_accuracy']} "
         f"(with several objects: {report['factor_accuracy_multi']}, n={report['n_multi']})  "
         f"grounded {report['grounded_share']}  true to the state {report['truthful_share']}  "
-        f"fallbacks {report['fallbacks']}"
+        f"fallbacks {report['fallbacks']}  vetoed {report['vetoed']}"
     )
     _write(out, report)
 

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import typer
 from rich.console import Console
 
 from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
+from explaindrive.cli._language_common import CONFIG_HELP, MODEL_HELP, read_config
 from explaindrive.language.backends import check_backend
 from explaindrive.language.encoders import check_installed
 
@@ -19,8 +22,8 @@ def serve(
         "127.0.0.1", "--host", help="Address to bind (local only by default)."
     ),
     port: int = typer.Option(8000, "--port", min=1, max=65535, help="TCP port."),
-    backend: str = typer.Option(
-        "embedded", "--backend", help="Language backend: embedded or openai."
+    backend: str | None = typer.Option(
+        None, "--backend", help="Language backend: embedded or openai (default: --config's)."
     ),
     step_period: float = typer.Option(
         1.0,
@@ -40,6 +43,8 @@ def serve(
     net: where.NetOption = None,
     route: where.RouteOption = None,
     demand: where.DemandOption = None,
+    language: Path | None = typer.Option(None, "--config", help=CONFIG_HELP),
+    model: str | None = typer.Option(None, "--model", help=MODEL_HELP),
 ) -> None:
     """Serve the passenger page: watch the ride, talk to the car, read its explanations."""
     from explaindrive.agent.checkpoint import CheckpointError
@@ -50,7 +55,8 @@ def serve(
     from explaindrive.web.server import run_server
 
     try:  # before the server starts
-        check_backend(backend)
+        language_config = read_config(language, model)
+        backend = check_backend(backend or language_config.backend)
         check_installed()
         if fast_policy is not None or comfort_policy is not None:  # loads them once to check
             MergedController.from_package(fast=fast_policy, comfort=comfort_policy)
@@ -64,7 +70,7 @@ def serve(
             f"[yellow]warning:[/yellow] binding {host} exposes the ride controls to the network"
         )
     console.print(f"answering Host names: {', '.join(sorted(hosts))}", highlight=False)
-    stack = RealStack(backend, fast_policy, comfort_policy, place)
+    stack = RealStack(backend, fast_policy, comfort_policy, place, language=language_config)
     app = create_app(stack, step_period_s=step_period, hosts=hosts, net_file=where.net_of(place))
     console.print(f"passenger page: http://{host}:{port}/  (Ctrl+C to stop)")
     run_server(app, host, port)

@@ -65,13 +65,20 @@ class EmbeddedConfig(_Strict):
 
 
 class OpenAIConfig(_Strict):
-    """Any OpenAI-compatible chat endpoint (OpenAI, Ollama, vLLM, llama.cpp)."""
+    """Any OpenAI-compatible chat endpoint (OpenAI, Ollama, vLLM, llama.cpp): where it is,
+    which model answers, where the key comes from, and how long a call may take."""
 
-    model: str = "gpt-4.1-mini"
+    model: str = Field(default="gpt-4.1-mini", min_length=1)
+    """The model name sent with every request (``--model`` replaces it)."""
     base_url: str | None = None
-    """``None`` = ``OPENAI_BASE_URL`` or the SDK default."""
+    """``None`` = the variable named by ``base_url_env``, else the SDK default."""
+    base_url_env: str = "OPENAI_BASE_URL"
+    """Environment variable read for the endpoint when ``base_url`` is ``None``."""
     api_key: str | None = None
-    """``None`` = ``OPENAI_API_KEY`` (a placeholder is used for local servers without one)."""
+    """``None`` = the variable named by ``api_key_env`` (a placeholder is sent to local
+    servers without one). Prefer the variable: a config file is easily shared."""
+    api_key_env: str = "OPENAI_API_KEY"
+    """Environment variable read for the key when ``api_key`` is ``None``."""
     timeout_s: float = Field(default=0.8, gt=0.0)
     """[s] total deadline of one call: connecting, sending, reading and retries. When it
     passes, the embedded module answers instead. A ride checks that it fits its own
@@ -91,6 +98,19 @@ class LanguageConfig(_Strict):
     speech: SpeechConfig = SpeechConfig()
     embedded: EmbeddedConfig = EmbeddedConfig()
     openai: OpenAIConfig = OpenAIConfig()
+
+    def with_model(self, model: str | None) -> LanguageConfig:
+        """This config with ``openai.model`` replaced (unchanged for ``None``).
+
+        Raises:
+            ValueError: for an empty name.
+        """
+        if model is None:
+            return self
+        if not model.strip():
+            raise ValueError("--model needs a model name")
+        remote = self.openai.model_copy(update={"model": model.strip()})
+        return self.model_copy(update={"openai": remote})
 
     def with_runtime(self, runtime: str) -> LanguageConfig:
         """This config with ``embedded.encoder_runtime`` replaced.

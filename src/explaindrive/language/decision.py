@@ -29,6 +29,7 @@ from explaindrive.language.hazards import (
     SHORT_TTC_S,
     Factor,
     braking_hazards,
+    leader_explains_firm_braking,
     leader_is_hazard,
     stopping_distance_m,
 )
@@ -81,6 +82,9 @@ class Decision:
         backend: backend that answered; ``fallback`` when ``embedded`` stood in.
         latency_s: wall time of the call [s].
         error: why the configured backend was bypassed, when ``fallback``.
+        vetoed: a remote ``[EXPLAIN]`` was overruled because the state holds no conflict
+            with the request or no safety factor to name.
+        raw_reply: the remote model's reply as it came (for the ride log only).
     """
 
     explain: bool
@@ -91,6 +95,8 @@ class Decision:
     fallback: bool = False
     latency_s: float = 0.0
     error: str | None = None
+    vetoed: bool = False
+    raw_reply: str | None = None
 
     @property
     def tag(self) -> str:
@@ -162,6 +168,12 @@ def rule_decision(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M) -> De
     factors = (
         acceleration_factors(s) if conflict is Conflict.HARSH_ACCELERATION else braking_factors(s)
     )
+    if (
+        conflict is Conflict.SLOWS
+        and Factor.LEAD_VEHICLE not in factors
+        and leader_explains_firm_braking(s, record.action)
+    ):
+        factors.append(Factor.LEAD_VEHICLE)  # firm braking for a leader not yet close
     if not factors:
         return Decision(
             False,

@@ -85,11 +85,19 @@ def intent_metrics(
 
 
 def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample]) -> dict[str, Any]:
-    """Run ``interpreter`` over labelled requests; metrics plus every error and latency."""
+    """Run ``interpreter`` over labelled requests; metrics plus every error and latency.
+
+    ``replies`` counts what became of a remote model's replies: ``accepted`` (read and
+    used), ``fallback`` (unreadable, an error or late: the embedded reading stood in),
+    ``vetoed`` (read, but overruled by a sure embedded reading) and ``not_asked`` (the
+    embedded STOP lane, or an empty line). ``by_kind`` gives [correct, total] per kind;
+    ``negated_stops_read_as_stop`` counts the rows of kind ``negated_stop`` read as STOP.
+    """
     preds: list[str] = []
     confs: list[str | None] = []
     latencies: list[float] = []
-    fallbacks = 0
+    replies = {"accepted": 0, "fallback": 0, "vetoed": 0, "not_asked": 0}
+    by_kind: dict[str, list[int]] = {}
     errors = []
     for row in rows:
         r = interpreter.interpret(row.text)
@@ -97,11 +105,38 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
         preds.append(label)
         confs.append(r.confirmation)
         latencies.append(r.latency_s)
-        fallbacks += r.fallback
+        if r.fallback:
+            replies["fallback"] += 1
+        elif r.overruled:
+            replies["vetoed"] += 1
+        elif r.raw_reply is not None:
+            replies["accepted"] += 1
+        else:
+            replies["not_asked"] += 1
+        tally = by_kind.setdefault(row.kind or "-", [0, 0])
+        tally[0] += label == row.label
+        tally[1] += 1
         if label != row.label:
-            errors.append({"text": row.text, "label": row.label, "pred": label, "kind": row.kind})
+            error: dict[str, str | None] = {
+                "text": row.text,
+                "label": row.label,
+                "pred": label,
+                "kind": row.kind,
+            }
+            if r.raw_reply is not None:
+                error.update(rule=r.rule, raw_reply=r.raw_reply)
+            errors.append(error)
     out = intent_metrics([r.label for r in rows], preds, confs)
-    out.update(errors=errors, fallbacks=fallbacks, latency=_percentiles(latencies))
+    out.update(
+        errors=errors,
+        fallbacks=replies["fallback"],
+        replies=replies,
+        by_kind=by_kind,
+        negated_stops_read_as_stop=sum(
+            p == "stop" for p, row in zip(preds, rows, strict=True) if row.kind == "negated_stop"
+        ),
+        latency=_percentiles(latencies),
+    )
     return out
 
 
@@ -123,7 +158,7 @@ def evaluate_decisions(
     texts: list[dict[str, Any]] = []
     lat_decide: list[float] = []
     lat_explain: list[float] = []
-    fallbacks = 0
+    fallbacks = vetoed = 0
     for row in rows:
         rec = row.record()
         d = decider.decide(rec)
@@ -131,6 +166,7 @@ def evaluate_decisions(
         pred.append(d.explain)
         lat_decide.append(d.latency_s)
         fallbacks += d.fallback
+        vetoed += d.vetoed
         if d.explain:
             e = explainer.explain(rec, d.factor)
             lat_explain.append(e.latency_s)
@@ -155,6 +191,7 @@ def evaluate_decisions(
         "grounded_share": _share([t["grounded"] for t in labelled]),
         "truthful_share": _share([not t["problems"] for t in texts]),
         "fallbacks": fallbacks,
+        "vetoed": vetoed,
         "latency": {"decide": _percentiles(lat_decide), "explain": _percentiles(lat_explain)},
         "explanations": texts,
     }

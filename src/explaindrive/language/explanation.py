@@ -15,7 +15,9 @@ from explaindrive.language.summary import RecordState, StateRecord
 _FACTOR_PATTERNS: dict[Factor, re.Pattern[str]] = {
     Factor.TRAFFIC_LIGHT: re.compile(r"\b(traffic[- ]lights?|lights?|signals?)\b", re.I),
     Factor.PEDESTRIAN: re.compile(
-        r"\b(pedestrians?|crosswalk|zebra|someone crossing|people crossing|person crossing)\b",
+        r"\b(pedestrians?|crosswalk|zebra|child(ren)?|kids?|walkers?|passers-by|passer-by)\b"
+        r"|\b(someone|somebody|people|person|a man|a woman)\s+((is|are)\s+)?"
+        r"(crossing|walking|on the (crossing|road|street))\b",
         re.I,
     ),
     Factor.LEAD_VEHICLE: re.compile(
@@ -37,6 +39,8 @@ class Explanation:
         backend: backend that answered; ``fallback`` when ``embedded`` stood in.
         latency_s: wall time of the call [s].
         error: why the configured backend was bypassed, when ``fallback``.
+        raw_reply: the remote model's reply as it came (for the ride log only; the
+            passenger sees ``text``).
     """
 
     text: str
@@ -45,6 +49,7 @@ class Explanation:
     fallback: bool = False
     latency_s: float = 0.0
     error: str | None = None
+    raw_reply: str | None = None
 
 
 class Explainer(ABC):
@@ -76,7 +81,13 @@ def present_factors(state: RecordState) -> set[Factor]:
 
 @dataclass(frozen=True, slots=True)
 class Grounding:
-    """Result of :func:`check_grounding`."""
+    """Result of :func:`check_grounding`.
+
+    Attributes:
+        names_factor: the text names the expected factor (with none expected: a factor
+            present in the state).
+        absent: factors the text names that the state does not hold.
+    """
 
     names_factor: bool
     absent: tuple[Factor, ...]
@@ -90,10 +101,13 @@ class Grounding:
 def check_grounding(
     text: str, factor: Factor | None, record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M
 ) -> Grounding:
-    """Check that ``text`` names ``factor`` and no factor absent from the state."""
+    """Check that ``text`` names ``factor`` (with ``None``: some factor present in the
+    state) and no factor absent from the state."""
     said = mentioned_factors(text)
-    absent = tuple(sorted(said - present_factors(record.nearby(cutoff_m))))
-    return Grounding(names_factor=factor is None or factor in said, absent=absent)
+    present = present_factors(record.nearby(cutoff_m))
+    absent = tuple(sorted(said - present))
+    names = bool(said & present) if factor is None else factor in said
+    return Grounding(names_factor=names, absent=absent)
 
 
 # --- the embedded generator ----------------------------------------------------------------
@@ -188,18 +202,32 @@ def _pick(options: tuple[str, ...], key: str) -> str:
 
 
 def opener_kind(record: StateRecord) -> str:
-    """How the record's action reads in words: ``stopping`` (this step ends at a
-    standstill), ``hard_brake`` (-3), ``firm_brake`` (-2), ``gentle_brake`` (-1), ``wait``
-    (standing), ``hold`` or ``accelerate``."""
+    """How the record's motion reads in words: ``wait`` (standing, not moving off),
+    ``accelerate``, ``stopping`` (this step ends at a standstill), ``hard_brake`` (-3),
+    ``firm_brake`` (-2), ``gentle_brake`` (-1, "easing off") or ``hold``.
+
+    A car that stands still is never said to brake or ease off, whatever the action.
+    """
     v = record.state.v_ego
     a = record.action
+    if v <= STANDSTILL_MPS and a <= 0:
+        return "wait"
     if a > 0:
         return "accelerate"
-    if a < 0 and v > STANDSTILL_MPS and v + a <= STANDSTILL_MPS:
+    if a < 0 and v + a <= STANDSTILL_MPS:
         return "stopping"
     if a < 0:
         return {-3: "hard_brake", -2: "firm_brake"}.get(a, "gentle_brake")
-    return "wait" if v <= STANDSTILL_MPS else "hold"
+    return "hold"
+
+
+def neutral_explanation(record: StateRecord) -> str:
+    """A sentence true of the motion that names no factor, for a state with nothing to name."""
+    kind = opener_kind(record)
+    opener = _pick(_OPENERS[kind], record.model_dump_json() + "o")
+    if kind == "accelerate":
+        return f"{opener}, it was the safer choice here."
+    return f"{opener}, it is the safe choice here."
 
 
 def template_explanation(

@@ -65,7 +65,9 @@ _UNSUPPORTED = re.compile(
     r"\b(cyclists?|bicycles?|bikes?|motorcycles?|scooters?|school zones?|schools?"
     r"|construction|road ?works|work zones?|animals?|dogs?|cats?|deer|ambulances?"
     r"|fire (engine|truck)s?|police|sirens?|rain|raining|wet|ice|icy|fog|foggy|snow"
-    r"|accidents?|crash(es)?|collisions?|potholes?|obstacles?|debris|swerv\w*|roadblocks?)\b",
+    r"|accidents?|crash(es)?|collisions?|potholes?|obstacles?|debris|swerv\w*|roadblocks?"
+    r"|(speed )?cameras?|radars?|speed traps?|traffic (conditions|jams?)|heavy traffic"
+    r"|congestion|rush hour|sharp (bend|curve|turn)s?|bends?|curves?|hills?)\b",
     _I,
 )
 _COLOURS = {"red": "red", "yellow": "yellow", "amber": "yellow", "green": "green"}
@@ -85,15 +87,16 @@ def wording_problems(text: str, record: StateRecord) -> list[str]:
     """What ``text`` says the car does that its action and speed do not bear out."""
     v = record.state.v_ego
     a = record.action
+    moving = v > STANDSTILL_MPS
     at_rest_after = v + a <= STANDSTILL_MPS
     stop_ahead = a < 0 and _has_stop_target(record.state)
     rules = (
         (_STOPPED, at_rest_after, "a stop"),
         (_STOP, at_rest_after or stop_ahead, "stopping"),
-        (_GENTLE, a == -1, "gentle braking"),
-        (_HARD, a <= -2, "hard braking"),
+        (_GENTLE, a == -1 and moving, "gentle braking"),
+        (_HARD, a <= -2 and moving, "hard braking"),
         (_ACCELERATING, a > 0, "accelerating"),
-        (_SLOWING, a < 0, "slowing down"),
+        (_SLOWING, a < 0 and moving, "slowing down"),
         (_HOLDING, a == 0 and v > STANDSTILL_MPS, "holding speed"),
         (_WAITING, a <= 0 and v <= STANDSTILL_MPS, "waiting"),
     )
@@ -128,8 +131,10 @@ def reply_problems(
     s = record.nearby(cutoff_m)
     problems: list[str] = []
     grounding = check_grounding(text, factor, record, cutoff_m)
-    if factor is not None and not grounding.names_factor:
+    if not grounding.names_factor and factor is not None:
         problems.append(f"does not name the {factor.value.replace('_', ' ')}")
+    elif not grounding.names_factor:
+        problems.append("names no factor of the state")
     if grounding.absent:
         problems.append(f"names factors not in the state: {', '.join(grounding.absent)}")
     invented = sorted({m.group(0).lower() for m in _UNSUPPORTED.finditer(text)})

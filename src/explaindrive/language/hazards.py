@@ -32,6 +32,8 @@ COMFORT_DECEL_MPS2 = 2.0  # [m/s^2] comfortable braking
 STANDSTILL_GAP_M = 2.0  # [m] gap kept to a stopped leader
 MIN_SPEED_MPS = 1.0  # [m/s] slower speeds count as this when timing a hazard
 CLOSING_MPS = 0.1  # [m/s] a leader is closing when the gap shrinks faster than this
+FIRM_BRAKE_MPS = -2  # [m/s] speed changes at or below this are firm or hard braking
+FIRM_BRAKE_HEADWAY_S = 4.0  # [s] a leader within this headway explains firm braking
 
 
 class Factor(StrEnum):
@@ -121,6 +123,19 @@ def leader_is_hazard(s: _State) -> bool:
     if s.d_lead is None:
         return False
     return s.d_lead < MIN_GAP_M or headway_s(s) < SHORT_HEADWAY_S or ttc_s(s) < SHORT_TTC_S
+
+
+def leader_explains_firm_braking(s: _State, action: int) -> bool:
+    """Whether the leader explains braking at ``action`` although it is no hazard yet.
+
+    A driving policy brakes firmly well before the leader is close: behind a leader that
+    is closing, or within :data:`FIRM_BRAKE_HEADWAY_S`, firm or hard braking
+    (``action <= FIRM_BRAKE_MPS``) is explained by it. ``s`` holds only objects within the
+    cut-off.
+    """
+    if s.d_lead is None or action > FIRM_BRAKE_MPS:
+        return False
+    return (s.dv or 0.0) > CLOSING_MPS or headway_s(s) < FIRM_BRAKE_HEADWAY_S
 
 
 def braking_hazards(s: _State) -> list[Hazard]:

@@ -45,6 +45,12 @@ class IntentResult:
             after its last repair marker that decided the command; else ``None``.
         stop_lane: ``True`` when the embedded STOP check answered before any remote
             model was asked (a STOP is never left waiting on an endpoint).
+        rule: with a remote model, the rule of :mod:`~explaindrive.language.agreement`
+            that chose between its reading and the embedded one; else ``None``.
+        overruled: the remote model's reply was read but the embedded reading stood
+            against it (rules ``local-sure-none`` and ``local-sure``).
+        raw_reply: the remote model's reply as it came, for the ride log only (the
+            passenger sees ``confirmation``).
     """
 
     intent: Command | None
@@ -56,6 +62,9 @@ class IntentResult:
     error: str | None = None
     instruction: str | None = None
     stop_lane: bool = False
+    rule: str | None = None
+    overruled: bool = False
+    raw_reply: str | None = None
 
     def to_json(self) -> dict[str, object]:
         """The CLI's JSON shape."""
@@ -66,6 +75,8 @@ class IntentResult:
             "fallback": self.fallback,
             "instruction": self.instruction,
             "stop_lane": self.stop_lane,
+            "rule": self.rule,
+            "overruled": self.overruled,
         }
 
 

@@ -160,7 +160,7 @@ class RideSession:
         self._newest_read = 0  # the latest request understood as a command
         self._inbox: list[dict[str, Any]] = []  # passenger events of the coming step
         self._obs: NDArray[np.float32] | None = None
-        self._last_explained: tuple[str | None, float] = (None, -math.inf)
+        self._explained_at: dict[str | None, float] = {}  # factor -> when last explained
         self.done = False
         self.latest_explanation: dict[str, Any] | None = None
 
@@ -381,6 +381,7 @@ class RideSession:
                 **result.to_json(),
                 "latency_s": round(out.latency_s, 4),
                 "error": result.error,
+                "raw_reply": result.raw_reply,  # for the log; the page drops it
             }
         )
         if result.intent is None:
@@ -446,17 +447,19 @@ class RideSession:
             "fallback": decision.fallback,
             "latency_s": round(out.latency_s, 4),
         }
+        if decision.raw_reply is not None:  # the ride log keeps what the model said
+            rec.decision.update(vetoed=decision.vetoed, raw_reply=decision.raw_reply)
         rec.latency_s["decide"] = out.latency_s
         self.counts.fallbacks += int(decision.fallback)
         if not decision.explain:
             return
         self.counts.explain_decisions += 1
-        last_factor, last_t = self._last_explained
-        if factor == last_factor and rec.t - last_t < self.config.explanation_cooldown_s:
+        last_t = self._explained_at.get(factor, -math.inf)
+        if rec.t - last_t < self.config.explanation_cooldown_s:  # rate-limited per factor
             self.counts.suppressed_explanations += 1
             rec.decision["suppressed"] = True
             return
-        self._last_explained = (factor, rec.t)
+        self._explained_at[factor] = rec.t
         self.lane.submit(
             "explain",
             self.language.explainer.explain,
@@ -476,6 +479,8 @@ class RideSession:
             "fallback": exp.fallback,
             "latency_s": round(out.latency_s, 4),
         }
+        if exp.raw_reply is not None:
+            rec.explanation["raw_reply"] = exp.raw_reply
         rec.latency_s["explain"] = out.latency_s
         self.counts.explanations += 1
         self.counts.fallbacks += int(exp.fallback)

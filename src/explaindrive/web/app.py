@@ -34,6 +34,7 @@ from starlette.datastructures import UploadFile
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from explaindrive.language.backends import check_backend
+from explaindrive.language.config import LanguageConfig
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.sim.scenario.files import default_scenario
@@ -80,6 +81,8 @@ class RealStack:
         comfort_policy: likewise for the comfort network.
         scenario: ride config fields choosing where the rides drive (the paper's road by
             default; see :class:`~explaindrive.sim.scenario.choice.ScenarioFields`).
+        language: the language layer's configuration (endpoint, model...); ``None`` =
+            the defaults.
     """
 
     def __init__(
@@ -88,24 +91,25 @@ class RealStack:
         fast_policy: Path | None = None,
         comfort_policy: Path | None = None,
         scenario: dict[str, Any] | None = None,
+        language: LanguageConfig | None = None,
     ) -> None:
         self.backend = check_backend(backend)
         self.policies = (fast_policy, comfort_policy)
         self.scenario = dict(scenario or {})
+        self.language_config = language or LanguageConfig()
         self._controller: Any = None
         self._language: Any = None
 
     def __call__(self, config: RideConfig) -> RideSession:
         """Build a ride session with ``config`` (its backend is replaced by this one's)."""
         from explaindrive.agent.controller import MergedController
-        from explaindrive.language.config import LanguageConfig
         from explaindrive.language.stack import make_language_stack
 
         fast, comfort = self.policies
         if self._controller is None:
             self._controller = MergedController.from_package(fast=fast, comfort=comfort)
         if self._language is None:
-            self._language = make_language_stack(self.backend, LanguageConfig()).load()
+            self._language = make_language_stack(self.backend, self.language_config).load()
         config = config.replace(backend=self.backend, fast_policy=fast, comfort_policy=comfort,
                                 **self.scenario)  # fmt: skip
         return RideSession(config, self._controller, self._language)

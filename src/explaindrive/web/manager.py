@@ -426,7 +426,8 @@ def _redacted(text: str | None) -> str | None:
 
 
 def _public_event(event: dict[str, Any]) -> dict[str, Any]:
-    """A passenger event without server file paths."""
+    """A passenger event without server file paths or a remote model's raw reply."""
+    event = {k: v for k, v in event.items() if k != "raw_reply"}
     if event.get("audio"):
         return {**event, "audio": "uploaded recording"}
-    return dict(event)
+    return event

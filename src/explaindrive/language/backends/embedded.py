@@ -10,7 +10,12 @@ from explaindrive.language.config import EmbeddedConfig
 from explaindrive.language.corrections import last_instruction
 from explaindrive.language.datasets import INTENT_LABELS
 from explaindrive.language.decision import Decision, ExplanationDecider, Factor, rule_decision
-from explaindrive.language.explanation import Explainer, Explanation, template_explanation
+from explaindrive.language.explanation import (
+    Explainer,
+    Explanation,
+    neutral_explanation,
+    template_explanation,
+)
 from explaindrive.language.features import SentenceEncoder, features
 from explaindrive.language.intent import (
     REPHRASE_MESSAGE,
@@ -19,11 +24,13 @@ from explaindrive.language.intent import (
     format_confirmation,
 )
 from explaindrive.language.intent_classifier import IntentClassifier
+from explaindrive.language.negation import stop_is_ruled_out
 from explaindrive.language.summary import StateRecord
 
 log = logging.getLogger(__name__)
 
 NAME = "embedded"
+_STOP = INTENT_LABELS.index("stop")
 
 
 class EmbeddedIntentInterpreter(IntentInterpreter):
@@ -52,7 +59,9 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
 
         A request that corrects itself is read by its last instruction: the part after
         its last repair marker (:func:`~explaindrive.language.corrections.last_instruction`)
-        decides whenever it asks for a command on its own.
+        decides whenever it asks for a command on its own. A line that mentions stopping
+        only negated or in a complaint
+        (:func:`~explaindrive.language.negation.stop_is_ruled_out`) is not read as STOP.
         """
         t0 = time.perf_counter()
         if not text or not text.strip():
@@ -60,6 +69,10 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         last = last_instruction(text)
         texts = [text] if last is None else [text, last]
         p = self.classifier.proba(features(self.encoder, texts, self.classifier.spec))
+        for i, t in enumerate(texts):  # "don't stop here", "another red light": not STOP
+            if stop_is_ruled_out(t):
+                p[i, _STOP] = 0.0
+                p[i] /= max(float(p[i].sum()), 1e-12)
         labels = [
             self.classifier.decide(row, self.config.stop_threshold, self.config.none_margin)
             for row in p
@@ -112,13 +125,17 @@ class TemplateExplainer(Explainer):
     def explain(self, record: StateRecord, factor: Factor | None) -> Explanation:
         """Explain ``record``'s action by ``factor`` (by the rule engine's pick when ``None``).
 
-        Raises:
-            ValueError: if no factor is given and the state holds no safety reason.
+        When the state holds no safety reason, or ``factor`` cannot explain the action,
+        the explanation names no factor (:func:`neutral_explanation`). Never raises.
         """
         t0 = time.perf_counter()
         if factor is None:
             factor = rule_decision(record, self.config.cutoff_m).factor
+        try:
             if factor is None:
-                raise ValueError("nothing to explain: no safety factor in the state")
-        text = template_explanation(record, factor, self.config.cutoff_m)
+                raise ValueError("no safety factor in the state")
+            text = template_explanation(record, factor, self.config.cutoff_m)
+        except ValueError as exc:
+            log.info("no grounded explanation (%s); a neutral one is given", exc)
+            text, factor = neutral_explanation(record), None
         return Explanation(text, factor, NAME, latency_s=time.perf_counter() - t0)

@@ -1,9 +1,13 @@
 """OpenAI-compatible backend (OpenAI, Ollama, vLLM, llama.cpp) with the paper's prompts.
 
-Every reply is validated (LLM-1 template, LLM-2 tag, LLM-3 checked against the state);
-a malformed or untrue reply, an HTTP error or a call past its total deadline falls back
-to the embedded module and the result says so (``fallback=True``, ``error=...``). The
-embedded interpreter reads every request first and answers a STOP itself.
+Every reply is read by :mod:`~explaindrive.language.replies` (tolerant of wrappers,
+strict in meaning) and held to the state: LLM-1's reading is weighed against the
+embedded one (:mod:`~explaindrive.language.agreement`), an LLM-2 ``[EXPLAIN]`` the state
+does not bear out is vetoed, and LLM-3's text is checked against the state
+(:mod:`~explaindrive.language.grounding`). A reply that cannot be read or is untrue, an
+HTTP error or a call past its total deadline falls back to the embedded module and the
+result says so (``fallback=True``, ``error=...``). The raw reply is kept in
+``raw_reply`` for the ride log; the passenger sees only the checked, cleaned result.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import time
 from typing import Any, TypeVar
 
 from explaindrive.commands import Command
+from explaindrive.language.agreement import reconcile
 from explaindrive.language.backends import deadline
 from explaindrive.language.backends.deadline import DeadlineExceededError
 from explaindrive.language.backends.embedded import (
@@ -24,16 +29,28 @@ from explaindrive.language.backends.embedded import (
 )
 from explaindrive.language.config import OpenAIConfig
 from explaindrive.language.decision import (
+    EXPLAIN_TAG,
+    NO_EXPLANATION_TAG,
     Decision,
     ExplanationDecider,
     Factor,
-    detect_conflict,
     most_critical_factor,
-    parse_decision_tag,
+    rule_decision,
 )
 from explaindrive.language.explanation import Explainer, Explanation
 from explaindrive.language.grounding import reply_problems
-from explaindrive.language.intent import IntentInterpreter, IntentResult, parse_confirmation
+from explaindrive.language.intent import (
+    REPHRASE_MESSAGE,
+    IntentInterpreter,
+    IntentResult,
+    format_confirmation,
+)
+from explaindrive.language.replies import (
+    NOT_A_REQUEST,
+    passenger_text,
+    read_confirmation,
+    read_decision_tag,
+)
 from explaindrive.language.summary import StateRecord, describe_action, environment_summary
 from explaindrive.redact import redact
 
@@ -41,8 +58,8 @@ log = logging.getLogger(__name__)
 
 NAME = "openai"
 
-# The paper's prompts, verbatim (section 4).
-INTENT_PROMPT = (
+# The paper's prompts, verbatim (section 4), LLM-1's with one sentence added.
+PAPER_INTENT_PROMPT = (
     "You are an autonomous taxi's AI assistant. Reformulate the passenger's request into a "
     "direct instruction about how the vehicle should drive. The instruction must correspond "
     "to one of the following driving styles: drive faster, drive more carefully, or stop. At "
@@ -50,6 +67,12 @@ INTENT_PROMPT = (
     '[action], is this correct?" Do not provide multiple options or add any extra text. Only '
     "output the direct confirmation question."
 )
+# The deviation (docs/language.md): a way to say that the line is not a driving request.
+NOT_A_REQUEST_INSTRUCTION = (
+    " If the passenger's words are not a request about how the vehicle should drive, "
+    f"output exactly: {NOT_A_REQUEST}"
+)
+INTENT_PROMPT = PAPER_INTENT_PROMPT + NOT_A_REQUEST_INSTRUCTION
 DECISION_PROMPT = """You are an AI reasoning module for an autonomous taxi. Your task is to output exactly ONE of:
 - [EXPLAIN]
 - [NO EXPLANATION NEEDED]
@@ -100,10 +123,10 @@ class ChatClient:
 
         self.config = config
         # the key sent to the endpoint, masked in any text that comes back
-        self.secret = config.api_key or os.environ.get("OPENAI_API_KEY")
+        self.secret = config.api_key or os.environ.get(config.api_key_env)
         self._client = OpenAI(
             api_key=self.secret or "not-needed",
-            base_url=config.base_url or os.environ.get("OPENAI_BASE_URL") or None,
+            base_url=config.base_url or os.environ.get(config.base_url_env) or None,
             timeout=config.timeout_s,
             max_retries=0,  # retried in complete(), within the call's deadline
             http_client=deadline.http_client(config.timeout_s),
@@ -159,15 +182,16 @@ def _err(exc: Exception, client: ChatClient) -> str:
 _R = TypeVar("_R", IntentResult, Decision, Explanation)
 
 
-def _as_fallback(result: _R, t0: float, error: str) -> _R:
-    """The embedded module's ``result``, marked as a fallback for ``error``, timed from ``t0``."""
+def _as_fallback(result: _R, t0: float, error: str, raw: str | None = None) -> _R:
+    """The embedded module's ``result``, marked as a fallback for ``error``, timed from
+    ``t0``, with the remote reply ``raw`` (when one came) kept for the log."""
     return dataclasses.replace(
-        result, fallback=True, latency_s=time.perf_counter() - t0, error=error
+        result, fallback=True, latency_s=time.perf_counter() - t0, error=error, raw_reply=raw
     )
 
 
 class OpenAIIntentInterpreter(IntentInterpreter):
-    """LLM-1 through the endpoint; falls back to the embedded interpreter."""
+    """LLM-1 through the endpoint, weighed against the embedded interpreter."""
 
     name = NAME
 
@@ -186,30 +210,54 @@ class OpenAIIntentInterpreter(IntentInterpreter):
 
         The embedded interpreter reads every request first (tens of milliseconds). A STOP
         found there is returned at once (``stop_lane=True``) without asking the endpoint,
-        so a STOP never waits on a remote model. Otherwise the endpoint's reply must be
-        exactly the confirmation template; on any failure, the deadline included, the
-        embedded reading stands in (``fallback=True``).
+        so a STOP never waits on a remote model. Otherwise the endpoint's reply is read
+        (:func:`~explaindrive.language.replies.read_confirmation`) and the two readings
+        are reconciled (:func:`~explaindrive.language.agreement.reconcile`). On any
+        failure, the deadline and an unreadable reply included, the embedded reading
+        stands in (``fallback=True``). The confirmation is always the template of the
+        command that counts, never the model's text.
         """
         t0 = time.perf_counter()
         local = self.fallback.interpret(text)
-        if local.intent is Command.STOP:
-            return dataclasses.replace(local, stop_lane=True, latency_s=time.perf_counter() - t0)
-        try:
-            reply = self.client.complete(INTENT_PROMPT, text, self.client.config.intent_temperature)
-            command = parse_confirmation(reply)
-            if command is None:
-                raise BackendReplyError(f"reply does not follow the template: {reply[:120]!r}")
-            return IntentResult(
-                command, reply.strip().strip("\"'"), NAME, False, time.perf_counter() - t0, {}
+        if local.intent is Command.STOP or not text.strip():
+            stop = local.intent is Command.STOP
+            return dataclasses.replace(
+                local,
+                stop_lane=stop,
+                rule="stop-local" if stop else None,
+                latency_s=time.perf_counter() - t0,
             )
+        raw: str | None = None
+        try:
+            raw = self.client.complete(INTENT_PROMPT, text, self.client.config.intent_temperature)
+            reading = read_confirmation(raw)
+            if not reading.ok:
+                raise BackendReplyError(f"reply not read: {reading.problem}: {raw[:120]!r}")
         except Exception as exc:  # any endpoint failure: answer offline instead
             error = _err(exc, self.client)
             log.warning("openai intent failed, using embedded: %s", error)
-            return _as_fallback(local, t0, error)
+            return _as_fallback(local, t0, error, raw)
+        label = local.intent.label if local.intent is not None else "none"
+        verdict = reconcile(local.intent, local.scores.get(label, 0.0), reading.command, NAME)
+        if verdict.source != "both":
+            log.info("intent readings differ for %r: %s (%s)", text, verdict.intent, verdict.rule)
+        own = verdict.source == "embedded"
+        return IntentResult(
+            verdict.intent,
+            format_confirmation(verdict.intent) if verdict.intent is not None else REPHRASE_MESSAGE,
+            NAME,
+            False,
+            time.perf_counter() - t0,
+            local.scores,
+            instruction=local.instruction if own else None,
+            rule=verdict.rule,
+            overruled=own,
+            raw_reply=raw,
+        )
 
 
 class OpenAIDecider(ExplanationDecider):
-    """LLM-2 through the endpoint; the factor comes from the grounded ranking."""
+    """LLM-2 through the endpoint, held to the state by the rule engine."""
 
     name = NAME
 
@@ -219,35 +267,49 @@ class OpenAIDecider(ExplanationDecider):
         self.fallback = fallback
 
     def decide(self, record: StateRecord) -> Decision:
-        """Ask for one tag; anything else falls back to the rule engine."""
+        """Ask for one tag; an unreadable reply falls back to the rule engine.
+
+        ``[NO EXPLANATION NEEDED]`` is followed. ``[EXPLAIN]`` is followed only when the
+        rule engine finds a conflict with the request and a safety factor to name (the
+        factor is the rule engine's); otherwise it is vetoed (``vetoed=True``, logged), so
+        an over-eager model never explains more than the rule engine would.
+        """
         t0 = time.perf_counter()
         cutoff = self.fallback.config.cutoff_m
+        raw: str | None = None
         try:
-            reply = self.client.complete(
+            raw = self.client.complete(
                 DECISION_PROMPT,
                 situation_message(record, cutoff),
                 self.client.config.decision_temperature,
             )
-            explain = parse_decision_tag(reply)
+            explain = read_decision_tag(raw)
             if explain is None:
-                raise BackendReplyError(f"reply is not one tag: {reply[:120]!r}")
-            factor = most_critical_factor(record, cutoff) if explain else None
-            return Decision(
-                explain,
-                factor,
-                detect_conflict(record, cutoff),
-                f"endpoint replied {reply.strip()}",
-                NAME,
-                latency_s=time.perf_counter() - t0,
-            )
+                raise BackendReplyError(f"reply is not one tag: {raw[:120]!r}")
         except Exception as exc:
             error = _err(exc, self.client)
             log.warning("openai decision failed, using rules: %s", error)
-            return _as_fallback(self.fallback.decide(record), t0, error)
+            return _as_fallback(self.fallback.decide(record), t0, error, raw)
+        rules = rule_decision(record, cutoff)
+        vetoed = explain and not rules.explain
+        reason = f"endpoint replied {EXPLAIN_TAG if explain else NO_EXPLANATION_TAG}"
+        if vetoed:
+            reason = f"vetoed {EXPLAIN_TAG}: {rules.reason}"
+            log.info("%s", reason)
+        return Decision(
+            explain and rules.explain,
+            rules.factor if explain and rules.explain else None,
+            rules.conflict,
+            reason,
+            NAME,
+            latency_s=time.perf_counter() - t0,
+            vetoed=vetoed,
+            raw_reply=raw,
+        )
 
 
 class OpenAIExplainer(Explainer):
-    """LLM-3 through the endpoint (temperature 0.2); ungrounded replies fall back."""
+    """LLM-3 through the endpoint (temperature 0.2); untrue replies fall back."""
 
     name = NAME
 
@@ -257,27 +319,38 @@ class OpenAIExplainer(Explainer):
         self.fallback = fallback
 
     def explain(self, record: StateRecord, factor: Factor | None) -> Explanation:
-        """Ask for an explanation and check it against the state before it is used.
+        """Ask for an explanation, clean it and check it against the state before use.
 
-        The reply must pass :func:`~explaindrive.language.grounding.reply_problems` (an
-        explanation naming the factor, no absent factor or invented hazard, the light's
+        The reply is reduced to plain text for the passenger
+        (:func:`~explaindrive.language.replies.passenger_text`) and must then pass
+        :func:`~explaindrive.language.grounding.reply_problems` (it names the factor, or
+        with none given a factor present in the state, and nothing absent; the light's
         true colour, distances and speeds near the state's, wording true of the action);
-        otherwise the template explanation stands in and ``error`` says why.
+        otherwise the template explanation stands in and ``error`` says why. With no
+        factor in the state the endpoint is not asked. Never raises.
         """
         t0 = time.perf_counter()
         cutoff = self.fallback.config.cutoff_m
         factor = factor or most_critical_factor(record, cutoff)
+        if factor is None:
+            return _as_fallback(
+                self.fallback.explain(record, None), t0, "no safety factor in the state"
+            )
+        raw: str | None = None
         try:
-            reply = self.client.complete(
+            raw = self.client.complete(
                 EXPLAIN_PROMPT,
                 situation_message(record, cutoff),
                 self.client.config.explain_temperature,
-            ).strip()
-            problems = reply_problems(reply, record, factor, cutoff)
+            )
+            text = passenger_text(raw)
+            problems = reply_problems(text, record, factor, cutoff)
             if problems:
                 raise BackendReplyError(f"explanation rejected: {'; '.join(problems)}")
-            return Explanation(reply, factor, NAME, latency_s=time.perf_counter() - t0)
+            return Explanation(
+                text, factor, NAME, latency_s=time.perf_counter() - t0, raw_reply=raw
+            )
         except Exception as exc:
             error = _err(exc, self.client)
             log.warning("openai explanation failed, using templates: %s", error)
-            return _as_fallback(self.fallback.explain(record, factor), t0, error)
+            return _as_fallback(self.fallback.explain(record, factor), t0, error, raw)
