@@ -18,17 +18,20 @@ run() {
 # The paper's grid (5 seeds x 5 traffic levels), shielded controller and baselines.
 for p in fast comfort krauss idm; do run "${p}_25" "$p" --seeds 0-4; done
 run merged_25 merged --seeds 0-4 --commands "fast:0-90,stop:90-110,comfort:110-"
-# The bare networks on ten times the paper's episodes, with and without stops, and on a
-# traffic level they were never trained on; then the shielded controller on the same grids.
-for p in fast comfort; do
-  run "${p}_bare" "$p" --seeds "$SEEDS" --no-shield
-  run "${p}_bare_stops" "$p" --seeds "$SEEDS" --no-shield --stop-schedule "$STOPS"
-  run "${p}_bare_175" "$p" --seeds "$SEEDS" --traffic 1.75 --no-shield
-  run "${p}_bare_175_stops" "$p" --seeds "$SEEDS" --traffic 1.75 --no-shield --stop-schedule "$STOPS"
-  run "${p}_shielded" "$p" --seeds "$SEEDS"
-  run "${p}_shielded_stops" "$p" --seeds "$SEEDS" --stop-schedule "$STOPS"
+# The bare networks and SUMO's Krauss and IDM on the same episodes: ten times the paper's
+# grid, with and without stops, and a traffic level no policy was trained on.
+for p in fast comfort krauss idm; do
+  bare=(); [[ $p == fast || $p == comfort ]] && bare=(--no-shield)
+  run "${p}_bare" "$p" --seeds "$SEEDS" "${bare[@]}"
+  run "${p}_bare_stops" "$p" --seeds "$SEEDS" "${bare[@]}" --stop-schedule "$STOPS"
+  run "${p}_bare_175" "$p" --seeds "$SEEDS" --traffic 1.75 "${bare[@]}"
+  run "${p}_bare_175_stops" "$p" --seeds "$SEEDS" --traffic 1.75 "${bare[@]}" --stop-schedule "$STOPS"
 done
-run krauss_large krauss --seeds "$SEEDS"
-run krauss_175 krauss --seeds "$SEEDS" --traffic 1.75
-run idm_large idm --seeds "$SEEDS"
-run merged_large merged --seeds "$SEEDS" --commands "fast:0-90,stop:90-110,comfort:110-"
+# The bare networks with sensor noise on what they see.
+for p in fast comfort; do
+  for noise in 1,0.3 2,0.6 3,0.9; do
+    run "${p}_bare_noise_${noise/,/_}" "$p" --seeds "$SEEDS" --no-shield --obs-noise "$noise"
+  done
+  run "${p}_bare_noise_1_0.3_stops" "$p" --seeds "$SEEDS" --no-shield --obs-noise 1,0.3 \
+    --stop-schedule "$STOPS"
+done
