@@ -409,10 +409,10 @@ WHY_NUMBERS_DIFFER: tuple[str, ...] = (
     "- Training budgets are listed under Policies (the paper trains 11,000 episodes with a "
     "5M replay buffer), and D3QN results vary between training seeds.",
     "- The SUMO baselines drive with SUMO's own safety model and are not in the paper; they "
-    "are a reference for what the scenario allows, not a reproduction target. Their "
-    "pedestrian-yield violations are passes while a pedestrian is still on the far half of "
-    "the crossing: SUMO lets a car through then, this project's rule (any pedestrian on the "
-    "crossing) does not.",
+    "are a reference for what the scenario allows, not a reproduction target. Every driver's "
+    "pedestrian-yield violations are counted by the same rule: crossing the stop line while "
+    "a pedestrian is in, or within a second of stepping into, the car's own lane; SUMO's "
+    "cars creep over the line at a zebra as a pedestrian steps off the kerb.",
     "- Our networks are trained to keep a kinematic safety rule (safe learning, "
     "`docs/agent.md`) and drive through the merged controller's shield built on the same "
     "rule (`agent/shield.py`), neither of which the paper has; `explaindrive evaluate fast "
