@@ -26,7 +26,7 @@ Definitions (one place; the README, docs/evaluation.md and the tables refer to t
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -59,31 +59,11 @@ class RideQualityResult:
     crossing_stop_gaps_m: tuple[float, ...]
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready dict."""
-        return {
-            "steps": self.steps,
-            "free_road_steps": self.free_road_steps,
-            "free_road_speed_sum": self.free_road_speed_sum,
-            "slow_free_road_steps": self.slow_free_road_steps,
-            "hard_brakes": self.hard_brakes,
-            "following_steps": self.following_steps,
-            "reversals": self.reversals,
-            "jerk_p95_mps3": self.jerk_p95_mps3,
-            "jerky_steps": self.jerky_steps,
-            "light_stop_gaps_m": list(self.light_stop_gaps_m),
-            "crossing_stop_gaps_m": list(self.crossing_stop_gaps_m),
-        }
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> RideQualityResult:
-        """Inverse of :meth:`as_dict`."""
-        return cls(
-            **{
-                **data,
-                "light_stop_gaps_m": tuple(data["light_stop_gaps_m"]),
-                "crossing_stop_gaps_m": tuple(data["crossing_stop_gaps_m"]),
-            }
-        )
+        """JSON-ready dict (the stop gaps as lists)."""
+        d = asdict(self)
+        d["light_stop_gaps_m"] = list(self.light_stop_gaps_m)
+        d["crossing_stop_gaps_m"] = list(self.crossing_stop_gaps_m)
+        return d
 
 
 def is_free_road(info: dict[str, Any]) -> bool:

@@ -168,12 +168,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             cfg.demand_file, cfg.scenario_every,
         )  # fmt: skip
         self.scenario: ScenarioFiles = self._scenarios.current
-        self.geometry: RouteGeometry = load_route_geometry(
-            self.scenario.net_file, self.scenario.route_edges
-        )
-        self._crossing_lanes: dict[str, CrossingLane] = crossing_lanes(
-            self.scenario.net_file, _approach_edges(self.geometry)
-        )
+        self.geometry: RouteGeometry
+        self._crossing_lanes: dict[str, CrossingLane]
+        self._load_geometry(self.scenario)
         if cfg.normalize_obs:
             low, high = S.normalize(S.STATE_LOW), S.normalize(S.STATE_HIGH)
         else:
@@ -425,13 +422,19 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise RuntimeError("no episode is running; call reset() first")
         return self._ep
 
+    def _load_geometry(self, scenario: ScenarioFiles) -> None:
+        """The route's geometry and the ego lane's stretch on each of its crossings."""
+        self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges)
+        self._crossing_lanes = crossing_lanes(
+            scenario.net_file, {c.crossing_edge: c.approach_edge for c in self.geometry.crossings}
+        )
+
     def _use_scenario(self, scenario: ScenarioFiles) -> None:
         """Drive the next episodes in ``scenario`` (a new draw under domain randomisation)."""
         if scenario is self.scenario:
             return
         self.scenario = scenario
-        self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges)
-        self._crossing_lanes = crossing_lanes(scenario.net_file, _approach_edges(self.geometry))
+        self._load_geometry(scenario)
         self._tls_link = {}
         self._conn.close()  # the next episode starts SUMO on the new network
 
@@ -665,13 +668,3 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep = self._ep
         seen = ep.noise.apply(obs, ep.noise_rng) if ep is not None else obs.copy()
         return S.normalize(seen) if self.config.normalize_obs else seen
-
-
-def _approach_edges(geometry: RouteGeometry) -> dict[str, str]:
-    """Each crossing of the route -> the route edge that leads to it."""
-    out = {}
-    for crossing in geometry.crossings:
-        for i, edge in enumerate(geometry.edges[:-1]):
-            if abs(geometry.edge_start_m[i + 1] - crossing.end_m) < 1e-6:
-                out[crossing.crossing_edge] = edge
-    return out

@@ -45,6 +45,7 @@ class RouteCrossing:
     stop_line_m: float  # [m] route position where the ego must stop for it
     signalized: bool
     end_m: float  # [m] route position where the junction holding it ends
+    approach_edge: str = ""  # the route edge that leads to it
 
 
 @dataclass(frozen=True, slots=True)
@@ -245,6 +246,7 @@ def _route_crossings(
                 stop_line_m=layout.end[route_in[0]],
                 signalized=nodes[node_id].get("type") == "traffic_light",
                 end_m=layout.starts[route_edges.index(route_in[0]) + 1],
+                approach_edge=route_in[0],
             )
         )
     return sorted(crossings, key=lambda c: c.stop_line_m)
