@@ -64,7 +64,11 @@ def resolve_config(
             "(stop is not a separate agent; both agents learn to obey it)"
         )
     changes: dict[str, Any] = dict(parse_override(item) for item in overrides)
-    changes.update({k: v for k, v in options.items() if v is not None})
+    place = {k: v for k, v in options.items() if v is not None}
+    if place.keys() & {"scenario", "net_file", "route"} and place.get("scenario") != "random":
+        # a scenario or network given on the command line replaces the preset's family
+        changes.update(scenario=None, scenario_paper_share=0.0)
+    changes.update(place)
     changes["mode"] = mode
     saved = _saved_config(out) if resume and preset is None else None
     if saved is not None:

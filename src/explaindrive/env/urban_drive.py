@@ -165,7 +165,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self.render_mode = render_mode
         self._scenarios = ScenarioSource(
             cfg.cache_dir or user_cache_dir(), cfg.scenario, cfg.net_file, cfg.route,
-            cfg.demand_file, cfg.scenario_every,
+            cfg.demand_file, cfg.scenario_every, cfg.scenario_paper_share,
         )  # fmt: skip
         self.scenario: ScenarioFiles = self._scenarios.current
         self.geometry: RouteGeometry

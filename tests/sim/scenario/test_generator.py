@@ -80,3 +80,12 @@ def test_scenarios_at_the_ends_of_the_ranges_drive(end: str, tmp_path: Path) -> 
         assert truncated or terminated
     finally:
         env.close()
+
+
+def test_a_quarter_of_the_episode_seeds_draw_the_papers_road() -> None:
+    from explaindrive.sim.scenario.generator import draws_paper_road
+
+    # 7919 is coprime to 1000: seeds 0-999 land on every residue once, 250 of them below 250
+    assert sum(draws_paper_road(seed, 0.25) for seed in range(1000)) == 250
+    assert not any(draws_paper_road(seed, 0.0) for seed in range(1000))
+    assert all(draws_paper_road(seed, 1.0) for seed in range(1000))

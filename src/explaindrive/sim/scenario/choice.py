@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Self
 
-from pydantic import PositiveInt, SerializerFunctionWrapHandler, model_serializer, model_validator
+from pydantic import Field, PositiveInt, SerializerFunctionWrapHandler, model_serializer, model_validator
 
 from explaindrive.config import FROM_LIST, StrictModel, TextPath
 
@@ -17,6 +17,8 @@ class ScenarioFields(StrictModel):
         scenario: a scenario directory (``explaindrive scenario build|random``), or
             ``"random"``: a new generated scenario every ``scenario_every`` episodes.
         scenario_every: episodes per drawn scenario under ``scenario="random"``.
+        scenario_paper_share: under ``scenario="random"``, the share of the draws that are
+            the paper's road instead of a generated scenario (decided by the episode seed).
         net_file: a SUMO network to use instead of the shipped scenario: with ``route``
             any network, else a build of the paper's road.
         route: ``(FROM_EDGE, TO_EDGE)``: the ego drives SUMO's route between them on
@@ -27,6 +29,7 @@ class ScenarioFields(StrictModel):
 
     scenario: str | None = None
     scenario_every: PositiveInt = 20
+    scenario_paper_share: float = Field(0.0, ge=0.0, le=1.0)
     net_file: TextPath | None = None
     route: Annotated[tuple[str, str], FROM_LIST] | None = None
     demand_file: TextPath | None = None
@@ -35,6 +38,8 @@ class ScenarioFields(StrictModel):
     def _check_scenario(self) -> Self:
         if self.scenario is not None and (self.net_file or self.route or self.demand_file):
             raise ValueError("give a scenario or a network (net_file/route/demand_file), not both")
+        if self.scenario_paper_share > 0.0 and self.scenario != "random":
+            raise ValueError("scenario_paper_share needs scenario='random'")
         if self.route is not None and self.net_file is None:
             raise ValueError("route needs net_file, the network it runs on")
         if self.demand_file is not None and self.route is None:
@@ -56,4 +61,4 @@ class ScenarioFields(StrictModel):
         return {k: getattr(self, k) for k in _SCENARIO_KEYS if getattr(self, k) is not None}
 
 
-_SCENARIO_KEYS = ("scenario", "scenario_every", "net_file", "route", "demand_file")
+_SCENARIO_KEYS = ("scenario", "scenario_every", "scenario_paper_share", "net_file", "route", "demand_file")

@@ -18,6 +18,7 @@ from explaindrive.sim.scenario.params import SIGNAL_FIXED_S, ScenarioParams
 TRAIN_SEED_START = 1_000_000
 """Scenario seeds of training draws start here; evaluation seeds lie below."""
 TRAIN_SEED_POOL = 1_000
+PAPER_DRAW_MULTIPLIER = 7_919  # a prime: spreads consecutive episode seeds over [0, 1000)
 """Training draws come from this many seeds, so built networks are reused (cached)."""
 
 # (low, high, step) of each drawn value; block lengths [m], limits [km/h], times [s],
@@ -99,6 +100,12 @@ def extreme_params(end: Literal["low", "high"]) -> ScenarioParams:
         return lo if end == "low" else hi
 
     return _params(pick)
+
+
+def draws_paper_road(episode_seed: int, share: float) -> bool:
+    """Whether a training draw for ``episode_seed`` is the paper's road, for a ``share`` of
+    the episode seeds (a fixed function of the seed, so a run is reproducible)."""
+    return share > 0.0 and (episode_seed * PAPER_DRAW_MULTIPLIER) % 1000 < share * 1000
 
 
 def training_seed(episode_seed: int) -> int:

@@ -22,6 +22,7 @@ class ScenarioSource:
         route: ``(from_edge, to_edge)`` of the ego's route on ``net_file``.
         demand_file: background demand on ``net_file`` (else generated trips).
         every: under :data:`RANDOM`, episodes per drawn scenario.
+        paper_share: under :data:`RANDOM`, the share of draws that are the paper's road.
 
     Raises:
         ValueError: (:class:`~explaindrive.sim.network.NetworkError` or
@@ -37,9 +38,11 @@ class ScenarioSource:
         route: tuple[str, str] | None = None,
         demand_file: Path | None = None,
         every: int = 1,
+        paper_share: float = 0.0,
     ) -> None:
         self._cache = cache_dir
         self._every = every
+        self._paper_share = paper_share
         self._episodes = 0
         self.random = scenario == RANDOM
         if self.random:
@@ -69,10 +72,14 @@ class ScenarioSource:
 
     def for_episode(self, episode_seed: int) -> ScenarioFiles:
         """The scenario of the next episode: under :data:`RANDOM` a new draw (from the
-        episode seed) every ``every`` episodes, else always the same."""
+        episode seed) every ``every`` episodes, the paper's road for a ``paper_share`` of the
+        draws; else always the same."""
         if self.random and self._episodes % self._every == 0:
-            from explaindrive.sim.scenario.generator import training_seed
+            from explaindrive.sim.scenario.generator import draws_paper_road, training_seed
 
-            self.current = self._draw(training_seed(episode_seed))
+            if draws_paper_road(episode_seed, self._paper_share):
+                self.current = default_scenario(self._cache)
+            else:
+                self.current = self._draw(training_seed(episode_seed))
         self._episodes += 1
         return self.current
