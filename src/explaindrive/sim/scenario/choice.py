@@ -4,7 +4,13 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Self
 
-from pydantic import Field, PositiveInt, SerializerFunctionWrapHandler, model_serializer, model_validator
+from pydantic import (
+    Field,
+    PositiveInt,
+    SerializerFunctionWrapHandler,
+    model_serializer,
+    model_validator,
+)
 
 from explaindrive.config import FROM_LIST, StrictModel, TextPath
 
@@ -61,4 +67,11 @@ class ScenarioFields(StrictModel):
         return {k: getattr(self, k) for k in _SCENARIO_KEYS if getattr(self, k) is not None}
 
 
-_SCENARIO_KEYS = ("scenario", "scenario_every", "scenario_paper_share", "net_file", "route", "demand_file")
+_SCENARIO_KEYS = (
+    "scenario",
+    "scenario_every",
+    "scenario_paper_share",
+    "net_file",
+    "route",
+    "demand_file",
+)
