@@ -121,12 +121,13 @@ def run_generalisation(
 
 def generalisation_section(by_run: Mapping[tuple[str, str], Sequence[EpisodeRecord]]) -> str:
     """The table: a row per policy; per scenario group mean speed, collisions, red-light
-    runs, pedestrian-yield violations and arrivals over its episodes."""
+    runs, pedestrian-yield violations, speeding steps and arrivals over its episodes."""
     policies = list(dict.fromkeys(name for name, _ in by_run))
     groups = list(dict.fromkeys(group for _, group in by_run))
     header = ["policy"]
     for group in groups:
-        header += [f"{group}: speed m/s", "collisions", "red runs", "ped viol.", "arrived"]
+        header += [f"{group}: speed m/s", "collisions", "red runs", "ped viol.", "speeding",
+                   "arrived"]  # fmt: skip
     lines = ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
     for name in policies:
         row = [name]
@@ -134,7 +135,7 @@ def generalisation_section(by_run: Mapping[tuple[str, str], Sequence[EpisodeReco
             recs = by_run.get((name, group), [])
             o = summarize(name, [(r.spec.traffic_level, r.result) for r in recs]).overall
             row += [fmt(o.mean_speed_mps), f"{o.collision_episodes}/{o.episodes}",
-                    str(o.red_light_runs), str(o.ped_violations),
+                    str(o.red_light_runs), str(o.ped_violations), str(o.speeding_steps),
                     f"{o.arrived}/{o.episodes}"]  # fmt: skip
         lines.append("| " + " | ".join(row) + " |")
     first = next(iter(by_run.values()), [])
@@ -142,7 +143,7 @@ def generalisation_section(by_run: Mapping[tuple[str, str], Sequence[EpisodeReco
     levels = sorted({r.spec.traffic_level for r in first})
     intro = (
         "\n## Generalisation\n\n"
-        f"Off the training road: the 20 generated scenarios held out from training "
+        f"Roads no policy was trained on: the 20 generated scenarios held out from training "
         f"(`{HELD_OUT}`) and two `netgenerate` networks (a grid and a spider web, every "
         f"junction signalised) with trips generated over them; seeds "
         f"{', '.join(map(str, seeds))}, traffic level(s) {', '.join(f'{x:g}' for x in levels)}."
