@@ -63,6 +63,7 @@ _SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 EGO_LENGTH_M = 5.0  # [m] as in the ego vType
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
+BACKLOG_DROP_AFTER_S = 30  # [s] after this wait the vehicles queued to enter there go too
 JUDGE_CROSSING_M = S.MAX_SPEED_MPS + 5.0  # [m] a crossing this close may be entered next step
 STRATEGIC_LANE_CHANGES = 0b011000000001  # SUMO lane-change mode: strategic changes only
 _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
@@ -456,7 +457,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             if EGO_ID in api.simulation.getDepartedIDList():
                 break
             if waited and waited % ENTRY_CLEAR_AFTER_S == 0:
-                self._clear_entry(drop_backlog)
+                self._clear_entry(drop_backlog or waited >= BACKLOG_DROP_AFTER_S)
         else:
             raise RuntimeError(
                 f"the ego could not enter within {self.config.insert_timeout_s} s "
