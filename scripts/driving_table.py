@@ -14,30 +14,34 @@ from pathlib import Path
 from typing import Any
 
 ROWS = (
-    ("fast", "fast_bare", "0-49 x 5 levels"),
-    ("fast + stops", "fast_bare_stops", "same, stops at 60-75 and 150-165 s"),
-    ("fast", "fast_bare_175", "0-49, traffic 1.75"),
-    ("fast + stops", "fast_bare_175_stops", "0-49, traffic 1.75"),
-    ("fast, noise 1 m / 0.3 m/s", "fast_bare_noise_1_0.3", "0-49 x 5 levels"),
-    ("fast + stops, noise 1 m / 0.3 m/s", "fast_bare_noise_1_0.3_stops", "0-49 x 5 levels"),
-    ("fast, noise 2 m / 0.6 m/s", "fast_bare_noise_2_0.6", "0-49 x 5 levels"),
-    ("fast, noise 3 m / 0.9 m/s", "fast_bare_noise_3_0.9", "0-49 x 5 levels"),
-    ("comfort", "comfort_bare", "0-49 x 5 levels"),
-    ("comfort + stops", "comfort_bare_stops", "same, stops at 60-75 and 150-165 s"),
-    ("comfort", "comfort_bare_175", "0-49, traffic 1.75"),
-    ("comfort + stops", "comfort_bare_175_stops", "0-49, traffic 1.75"),
-    ("comfort, noise 1 m / 0.3 m/s", "comfort_bare_noise_1_0.3", "0-49 x 5 levels"),
-    ("comfort + stops, noise 1 m / 0.3 m/s", "comfort_bare_noise_1_0.3_stops", "0-49 x 5 levels"),
-    ("comfort, noise 2 m / 0.6 m/s", "comfort_bare_noise_2_0.6", "0-49 x 5 levels"),
-    ("comfort, noise 3 m / 0.9 m/s", "comfort_bare_noise_3_0.9", "0-49 x 5 levels"),
-    ("SUMO Krauss", "krauss_bare", "0-49 x 5 levels"),
-    ("SUMO Krauss + stops", "krauss_bare_stops", "same, stops at 60-75 and 150-165 s"),
-    ("SUMO Krauss", "krauss_bare_175", "0-49, traffic 1.75"),
-    ("SUMO Krauss + stops", "krauss_bare_175_stops", "0-49, traffic 1.75"),
-    ("SUMO IDM", "idm_bare", "0-49 x 5 levels"),
-    ("SUMO IDM + stops", "idm_bare_stops", "same, stops at 60-75 and 150-165 s"),
-    ("SUMO IDM", "idm_bare_175", "0-49, traffic 1.75"),
-    ("SUMO IDM + stops", "idm_bare_175_stops", "0-49, traffic 1.75"),
+    ("fast", "fast_bare"),
+    ("fast + stops", "fast_bare_stops"),
+    ("fast", "fast_bare_175"),
+    ("fast + stops", "fast_bare_175_stops"),
+    ("fast, noise 1 m / 0.3 m/s", "fast_bare_noise_1_0.3"),
+    ("fast + stops, noise 1 m / 0.3 m/s", "fast_bare_noise_1_0.3_stops"),
+    ("fast, noise 2 m / 0.6 m/s", "fast_bare_noise_2_0.6"),
+    ("fast, noise 3 m / 0.9 m/s", "fast_bare_noise_3_0.9"),
+    ("comfort", "comfort_bare"),
+    ("comfort + stops", "comfort_bare_stops"),
+    ("comfort", "comfort_bare_175"),
+    ("comfort + stops", "comfort_bare_175_stops"),
+    ("comfort, noise 1 m / 0.3 m/s", "comfort_bare_noise_1_0.3"),
+    ("comfort + stops, noise 1 m / 0.3 m/s", "comfort_bare_noise_1_0.3_stops"),
+    ("comfort, noise 2 m / 0.6 m/s", "comfort_bare_noise_2_0.6"),
+    ("comfort, noise 3 m / 0.9 m/s", "comfort_bare_noise_3_0.9"),
+    ("fast, the paper's rewards (`--preset safe`)", "fast_paper_bare"),
+    ("fast + stops, the paper's rewards", "fast_paper_bare_stops"),
+    ("comfort, the paper's rewards (`--preset safe`)", "comfort_paper_bare"),
+    ("comfort + stops, the paper's rewards", "comfort_paper_bare_stops"),
+    ("SUMO Krauss", "krauss_bare"),
+    ("SUMO Krauss + stops", "krauss_bare_stops"),
+    ("SUMO Krauss", "krauss_bare_175"),
+    ("SUMO Krauss + stops", "krauss_bare_175_stops"),
+    ("SUMO IDM", "idm_bare"),
+    ("SUMO IDM + stops", "idm_bare_stops"),
+    ("SUMO IDM", "idm_bare_175"),
+    ("SUMO IDM + stops", "idm_bare_175_stops"),
 )
 HEADER = (
     "driver", "episodes (seeds)", "mean speed m/s", "free-road speed (of the limit)",
@@ -56,7 +60,21 @@ def _pct(share: float | None) -> str:
     return "–" if share is None else f"{100 * share:.1f} %"
 
 
-def row(label: str, grid: str, run: dict[str, Any]) -> list[str]:
+def _span(values: list[int]) -> str:
+    """``0-49`` for consecutive seeds, else the list."""
+    if values == list(range(values[0], values[-1] + 1)) and len(values) > 2:
+        return f"{values[0]}-{values[-1]}"
+    return ", ".join(map(str, values))
+
+
+def grid(run: dict[str, Any]) -> str:
+    """The run's seeds and traffic levels, as the table names them."""
+    levels = run["traffic_levels"]
+    where = f"{len(levels)} levels" if len(levels) > 1 else f"traffic {levels[0]:g}"
+    return f"seeds {_span(run['seeds'])} x {where}"
+
+
+def row(label: str, run: dict[str, Any]) -> list[str]:
     """One table row of a run document."""
     a = run["aggregates"]["overall"]
     episodes = run["episodes"]
@@ -66,7 +84,7 @@ def row(label: str, grid: str, run: dict[str, Any]) -> list[str]:
     stops = "–" if not a["stops"] else f"{a['stop_bound_misses']} of {a['stops']}"
     gaps = f"{_num(a['light_stop_gap_mean_m'], 1)} / {_num(a['crossing_stop_gap_mean_m'], 1)}"
     return [
-        label, f"{a['episodes']} ({grid})", _num(a["mean_speed_mps"]),
+        label, f"{a['episodes']} ({grid(run)})", _num(a["mean_speed_mps"]),
         _pct(a["free_road_speed_share"]), _pct(a["slow_free_road_share"]),
         _num(a["hard_brakes_per_episode"], 2), _num(a["reversals_per_min"], 2),
         _num(a["avg_jerk_mps3"]), gaps, str(a["collision_episodes"]), str(a["red_light_runs"]),
@@ -78,11 +96,11 @@ def row(label: str, grid: str, run: dict[str, Any]) -> list[str]:
 def main(folder: Path) -> None:
     """Print the table of every run found in ``folder``."""
     lines = ["| " + " | ".join(HEADER) + " |", "|" + "---|" * len(HEADER)]
-    for label, name, grid in ROWS:
+    for label, name in ROWS:
         path = folder / f"{name}.json"
         if path.is_file():
             run = json.loads(path.read_text(encoding="utf-8"))["runs"][0]
-            lines.append("| " + " | ".join(row(label, grid, run)) + " |")
+            lines.append("| " + " | ".join(row(label, run)) + " |")
     print("\n".join(lines))
 
 

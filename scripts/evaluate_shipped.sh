@@ -27,6 +27,18 @@ for p in fast comfort krauss idm; do
   run "${p}_bare_175" "$p" --seeds "$SEEDS" --traffic 1.75 "${bare[@]}"
   run "${p}_bare_175_stops" "$p" --seeds "$SEEDS" --traffic 1.75 "${bare[@]}" --stop-schedule "$STOPS"
 done
+# The networks trained on the paper's rewards (preset safe; shipped until commit PAPER_REF),
+# bare, on the same episodes.
+PAPER_REF=${PAPER_REF:-f1fcf2a}
+for p in fast comfort; do
+  dir=out/paper-rewards/$p
+  mkdir -p "$dir"
+  for f in pt json; do
+    git show "$PAPER_REF:src/explaindrive/agent/policies/$p.$f" > "$dir/policy.$f"
+  done
+  run "${p}_paper_bare" "$dir" --seeds "$SEEDS" --no-shield
+  run "${p}_paper_bare_stops" "$dir" --seeds "$SEEDS" --no-shield --stop-schedule "$STOPS"
+done
 # The bare networks with sensor noise on what they see.
 for p in fast comfort; do
   for noise in 1,0.3 2,0.6 3,0.9; do
