@@ -332,3 +332,18 @@ def test_the_ego_enters_the_busiest_road(make_env) -> None:
     env = make_env(traffic_level=2.0, max_steps=5)
     env.reset(seed=7)
     assert env.sumo.simulation.getTime() == 180 + 12
+
+
+def test_a_blocked_entry_at_175_drops_the_queue_after_30_s(tmp_path) -> None:
+    from explaindrive.env.urban_drive import UrbanDriveEnv
+    from explaindrive.evaluation.scenarios import random_case
+
+    # generated scenario 108 at 1.75 keeps its first road blocked: clearing its first 30 m
+    # every 10 s is not enough, so at 30 s the cars queued to enter go too and the ego
+    # enters in the next step, 32 s after the 180 s warm-up (it stayed out for 60 s before)
+    env = UrbanDriveEnv(dict(random_case(108, tmp_path).fields) | {"cache_dir": tmp_path})
+    try:
+        env.reset(seed=0, options={"traffic_level": 1.75})
+        assert env.sumo.simulation.getTime() == 180 + 32
+    finally:
+        env.close()
