@@ -29,7 +29,7 @@ from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.schedule import EpisodePlan, plan_episode
-from explaindrive.agent.shield import runtime_mask, training_mask
+from explaindrive.agent.shield import limit_mask, runtime_mask, training_mask
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.sim.scenario.layout import SEED_LIMIT
 
@@ -84,6 +84,18 @@ def _true_state(obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
     network that sees noisy observations learns the margin the noise calls for."""
     true = info.get("true_obs")
     return obs if true is None else np.asarray(true, dtype=np.float32)
+
+
+def learning_mask(seen: np.ndarray, true: np.ndarray, dilemma_braking: bool) -> np.ndarray:
+    """The safe actions learning uses: the training mask of the true state and, when the
+    network sees a noisy speed, the posted-limit rule on what it sees as well (a car that
+    sees itself over the limit slows down, which keeps a margin below the limit under
+    noise). If the two leave nothing, the true state's mask alone."""
+    mask = training_mask(true, dilemma_braking)
+    if seen is true:
+        return mask
+    both = mask & limit_mask(seen)
+    return both if both.any() else mask
 
 
 class NStepQueue:
@@ -263,7 +275,7 @@ class RolloutWorker:
             return _Running(
                 plan, summary, NStepQueue(c.n_step, c.gamma),
                 np.random.default_rng([c.seed, 3, plan.index]), obs,
-                training_mask(true_obs, c.dilemma_braking), runtime_mask(true_obs),
+                learning_mask(obs, true_obs, c.dilemma_braking), runtime_mask(true_obs),
             )  # fmt: skip
         raise RuntimeError(
             f"worker {self.worker_id}: episode {plan.index} failed to start "
@@ -279,7 +291,7 @@ class RolloutWorker:
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         next_obs = np.asarray(next_obs, dtype=np.float32)
         next_true = _true_state(next_obs, info)
-        next_mask = training_mask(next_true, self.config.dilemma_braking)
+        next_mask = learning_mask(next_obs, next_true, self.config.dilemma_braking)
         done = bool(terminated or truncated)
         out.transitions += ep.queue.push(
             ep.obs, action, float(reward), ep.mask, next_obs, next_mask, bool(terminated), done

@@ -77,9 +77,7 @@ def safe_action_mask(
     v = x[:, S.V_EGO : S.V_EGO + 1]  # (B, 1)
     v_new = np.maximum(v + _CHANGES, 0.0)  # (B, 7)
     need = stopping_needs(v_new)
-
-    over_limit = v_new > x[:, S.V_LIM : S.V_LIM + 1]
-    safe = ~(over_limit & (v_new > v - MAX_BRAKE_MPS + 1e-9))
+    safe = _within_limit(x)
 
     d_cross = x[:, S.D_CROSS : S.D_CROSS + 1]
     safe &= ~((d_cross < S.SENSOR_RANGE_M) & (need > d_cross))
@@ -106,6 +104,22 @@ def safe_action_mask(
         clearing = must_go & (v_new == v)  # in the dilemma zone: clear the junction first
         safe &= ~(stopping & ~closer & ~clearing)
     return safe[0] if single else safe
+
+
+def _within_limit(x: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Rows ``(B, 8)`` -> ``(B, 7)``: the actions that keep within the posted limit; above
+    it, only the hardest braking."""
+    v = x[:, S.V_EGO : S.V_EGO + 1]
+    v_new = np.maximum(v + _CHANGES, 0.0)
+    return ~((v_new > x[:, S.V_LIM : S.V_LIM + 1]) & (v_new > v - MAX_BRAKE_MPS + 1e-9))
+
+
+def limit_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
+    """The posted-limit rule of :func:`safe_action_mask` alone, for raw observations of shape
+    ``(B, 8)`` (or ``(8,)``)."""
+    x = np.asarray(obs, dtype=np.float64)
+    mask = _within_limit(x.reshape(-1, S.STATE_DIM))
+    return mask[0] if x.ndim == 1 else mask
 
 
 def _with_fallback(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
