@@ -112,6 +112,18 @@ def grid_net(directory: Path, options: list[str]) -> Path:
     return out
 
 
+def _checked_mask(obs: np.ndarray, info: dict[str, Any]) -> dict[str, Any]:
+    """``info`` without its action mask, after checking that the mask is the shield's rule
+    on the true state (the recording does not hold the mask)."""
+    from explaindrive.env.safety import runtime_mask
+
+    info = dict(info)
+    mask = info.pop("action_mask")
+    true_obs = info.get("true_obs", obs)
+    assert mask.dtype == np.bool_ and np.array_equal(mask, runtime_mask(true_obs)), info["time_s"]
+    return info
+
+
 def record(make_env: Any, case: dict[str, Any], tmp_dir: Path) -> list[dict[str, Any]]:
     """Play one case; the first record is the reset's (obs, info)."""
     from explaindrive.env import state as S
@@ -125,7 +137,7 @@ def record(make_env: Any, case: dict[str, Any], tmp_dir: Path) -> list[dict[str,
     driver = drivers[case["driver"]]
     rng = np.random.default_rng(case["seed"])
     obs, info = env.reset(seed=case["seed"], options=case["options"])
-    steps = [{"obs": _plain(obs), "info": _plain(info)}]
+    steps = [{"obs": _plain(obs), "info": _plain(_checked_mask(obs, info))}]
     done = False
     while not done:
         raw = S.denormalize(obs) if case["config"].get("normalize_obs") else obs
@@ -135,7 +147,8 @@ def record(make_env: Any, case: dict[str, Any], tmp_dir: Path) -> list[dict[str,
         done = terminated or truncated
         steps.append({
             "action": action, "obs": _plain(obs), "reward": float(reward),
-            "terminated": terminated, "truncated": truncated, "info": _plain(info),
+            "terminated": terminated, "truncated": truncated,
+            "info": _plain(_checked_mask(obs, info)),
         })  # fmt: skip
     return steps
 

@@ -29,6 +29,7 @@ from explaindrive.env.lights import AmberDecision
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.perception import LeaderSensor, Percept, Perception
 from explaindrive.env.reward import RECIPES, RewardTerms, reward_terms
+from explaindrive.env.safety import runtime_mask
 from explaindrive.env.sumo_process import SUMO_DRIVES, EgoEntry, Motion, SumoProcess
 from explaindrive.env.violations import ViolationJudge
 from explaindrive.sim.crossing_lanes import CrossingLane, crossing_lanes
@@ -51,6 +52,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     ``command_schedule`` [(time_s, command), ...] and ``obs_noise`` (sd_m, sd_mps). See
     :mod:`explaindrive.env.state` for the observation, :mod:`explaindrive.env.reward` for the
     rewards and :mod:`explaindrive.env.noise` for the observation noise.
+
+    ``info["action_mask"]`` after ``reset`` and ``step``, and :meth:`action_masks` at any
+    time, give the 7 actions the run-time shield allows in the true state
+    (:func:`explaindrive.env.safety.runtime_mask`), as masked-action learners expect.
     """
 
     metadata = {"render_modes": ["human"], "render_fps": 1}  # noqa: RUF012
@@ -118,6 +123,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         measured from it)."""
         return self._episode().pos_m
 
+    def action_masks(self) -> NDArray[np.bool_]:
+        """The actions the run-time shield allows in the current true state (a copy, shape
+        ``(7,)``): :func:`~explaindrive.env.safety.runtime_mask` of the raw observation
+        without sensor noise, with the active command."""
+        return runtime_mask(self._last_obs)
+
     @property
     def _ego_length_m(self) -> float:
         """The ego's length [m] as read from SUMO when it last entered (0 before)."""
@@ -174,6 +185,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             "seed": int(sumo_seed),
             "time_s": 0.0,
             "distance_m": 0.0,
+            "action_mask": self.action_masks(),
         }
         if ep.noise.active:
             info["true_obs"] = obs.copy()
@@ -215,6 +227,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep.done = terminated or truncated
         self._last_obs = obs
         info = step.info(ep, obs, self.geometry.limit_at(ep.pos_m), terms)
+        info["action_mask"] = self.action_masks()
         if ep.noise.active:
             info["true_obs"] = obs.copy()
         return self._output(obs), terms.total, terminated, truncated, info
