@@ -28,6 +28,7 @@ from explaindrive.env.episode import Episode, StepRecord
 from explaindrive.env.lights import AmberDecision
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.perception import LeaderSensor, Percept, Perception
+from explaindrive.env.render import TopDownView
 from explaindrive.env.reward import RECIPES, RewardTerms, reward_terms
 from explaindrive.env.safety import runtime_mask
 from explaindrive.env.sumo_process import SUMO_DRIVES, EgoEntry, Motion, SumoProcess
@@ -45,7 +46,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     Args:
         config: an :class:`EnvConfig` or a mapping of its fields (unknown keys rejected).
-        render_mode: ``None`` (libsumo, headless) or ``"human"`` (sumo-gui over TraCI).
+        render_mode: ``None`` (libsumo, headless), ``"rgb_array"`` (libsumo; :meth:`render`
+            returns a top-down view as an ``(H, W, 3)`` uint8 array) or ``"human"`` (sumo-gui
+            over TraCI draws every step).
         **overrides: individual config fields, e.g. ``traffic_level=0.5``.
 
     Reset options: ``command`` (fast|comfort|stop), ``traffic_level``,
@@ -58,7 +61,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     (:func:`explaindrive.env.safety.runtime_mask`), as masked-action learners expect.
     """
 
-    metadata = {"render_modes": ["human"], "render_fps": 1}  # noqa: RUF012
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 1}  # noqa: RUF012
 
     def __init__(
         self,
@@ -67,8 +70,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         **overrides: Any,
     ) -> None:
         super().__init__()
-        if render_mode not in (None, "human"):
-            raise ValueError(f"render_mode must be None or 'human', got {render_mode!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode must be None, 'human' or 'rgb_array', got {render_mode!r}"
+            )
         if isinstance(config, EnvConfig):
             cfg = config.replace(**overrides) if overrides else config
         else:
@@ -94,6 +99,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._entry: EgoEntry | None = None
         self._leader_lengths: dict[str, float] = {}  # vehicle id -> length [m]
         self._last_obs = np.zeros(S.STATE_DIM, dtype=np.float32)
+        self._view: TopDownView | None = None
 
     # ------------------------------------------------------------------ public API
     @property
@@ -231,6 +237,23 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         if ep.noise.active:
             info["true_obs"] = obs.copy()
         return self._output(obs), terms.total, terminated, truncated, info
+
+    def render(self) -> NDArray[np.uint8] | None:
+        """Under ``render_mode="rgb_array"``, the top-down view around the ego
+        (:mod:`explaindrive.env.render`); ``None`` otherwise (sumo-gui draws under
+        ``"human"``).
+
+        Raises:
+            RuntimeError: if no episode is running.
+        """
+        if self.render_mode != "rgb_array":
+            return None
+        api = self._sumo.api if self._ep is not None else None
+        if api is None:
+            raise RuntimeError("no episode is running; call reset() first")
+        if self._view is None or self._view.net_file != self.scenario.net_file:
+            self._view = TopDownView(self.scenario.net_file)
+        return self._view(api)
 
     def close(self) -> None:
         """Stop SUMO (idempotent)."""
