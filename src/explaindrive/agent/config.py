@@ -37,6 +37,8 @@ from explaindrive.config import (
     one_of,
     read_yaml,
 )
+from explaindrive.env.curriculum import SCHEDULE_HORIZON_S, STOP_DURATION_S, STOP_GAP_S
+from explaindrive.env.curriculum import SEED_POOL_BASE as SEED_POOL_BASE  # re-exported
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
 from explaindrive.env.noise import NoiseSD
 from explaindrive.env.reward import REWARD_NAMES
@@ -45,7 +47,6 @@ from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 TRAIN_MODES: tuple[str, ...] = (Command.FAST.label, Command.COMFORT.label)
 LOSSES: tuple[str, ...] = ("mse", "huber")
-SEED_POOL_BASE = 100_000  # training seeds from a pool start here, clear of evaluation seeds
 
 Fraction = Annotated[float, Field(ge=0.0, le=1.0)]  # a probability or a share
 Range = Annotated[tuple[float, float], FROM_LIST]  # [min, max], 0 < min <= max
@@ -117,11 +118,11 @@ class TrainConfig(ConfigModel, ScenarioFields):
         TRAFFIC_LEVELS
     )
     """Traffic levels sampled uniformly per episode (1.0 = 900 veh/h on the main road)."""
-    stop_gap_s: Range = (15.0, 60.0)
+    stop_gap_s: Range = STOP_GAP_S
     """Range [s] of the random time before each injected stop command (even episodes)."""
-    stop_duration_s: Range = (5.0, 15.0)
+    stop_duration_s: Range = STOP_DURATION_S
     """Range [s] of the random duration of each injected stop command."""
-    schedule_horizon_s: PositiveFloat = 900.0
+    schedule_horizon_s: PositiveFloat = SCHEDULE_HORIZON_S
     """Stop commands are scheduled up to this simulated time [s]."""
     seed_pool: PositiveInt | None = None
     """If set, episode seeds are drawn from this many values (``SEED_POOL_BASE`` onwards), so

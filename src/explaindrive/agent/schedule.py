@@ -3,7 +3,9 @@
 In even-numbered episodes the primary command (fast or comfort) is interleaved with stop
 commands at random intervals; in odd-numbered episodes it holds for the whole episode. The
 traffic level and the simulation seed vary per episode. Every plan is a pure function of
-the run seed and the episode index, so a resumed run replays the same episodes.
+the run seed and the episode index, so a resumed run replays the same episodes. The rules
+are those of :mod:`explaindrive.env.curriculum`, which the Gymnasium wrappers of
+:mod:`explaindrive.env.wrappers` apply for any learner.
 """
 
 from __future__ import annotations
@@ -13,9 +15,11 @@ from typing import Any
 
 import numpy as np
 
-from explaindrive.agent.config import SEED_POOL_BASE, TrainConfig
+from explaindrive.agent.config import TrainConfig
 from explaindrive.commands import Command
-from explaindrive.sim.scenario.layout import SEED_LIMIT
+from explaindrive.env.curriculum import draw_level, draw_seed, stop_schedule, stops_injected
+
+__all__ = ["EpisodePlan", "plan_episode", "stop_schedule"]
 
 
 @dataclass(frozen=True)
@@ -46,43 +50,16 @@ class EpisodePlan:
         return options
 
 
-def stop_schedule(
-    rng: np.random.Generator,
-    primary: Command,
-    gap_s: tuple[float, float],
-    duration_s: tuple[float, float],
-    horizon_s: float,
-) -> tuple[tuple[float, str], ...]:
-    """Alternate ``primary`` with stop commands at random times up to ``horizon_s``.
-
-    Each cycle waits ``U(gap_s)`` seconds of the primary command, then holds stop for
-    ``U(duration_s)`` seconds. Times are rounded to whole seconds (the decision step).
-    """
-    switches: list[tuple[float, str]] = []
-    t = 0.0
-    while True:
-        t += max(1.0, round(float(rng.uniform(*gap_s))))
-        if t >= horizon_s:
-            break
-        switches.append((t, Command.STOP.label))
-        t += max(1.0, round(float(rng.uniform(*duration_s))))
-        switches.append((t, primary.label))
-    return tuple(switches)
-
-
 def plan_episode(config: TrainConfig, index: int) -> EpisodePlan:
     """The plan of episode ``index`` (0-based; episode 0 is even) of a run."""
     if index < 0:
         raise ValueError(f"episode index must be >= 0, got {index}")
     rng = np.random.default_rng([config.seed, index])
-    if config.seed_pool is None:
-        seed = int(rng.integers(0, SEED_LIMIT - 1))
-    else:
-        seed = SEED_POOL_BASE + int(rng.integers(config.seed_pool))
-    level = float(config.traffic_levels[int(rng.integers(len(config.traffic_levels)))])
+    seed = draw_seed(rng, config.seed_pool)
+    level = draw_level(rng, config.traffic_levels)
     primary = config.command
     schedule: tuple[tuple[float, str], ...] = ()
-    if index % 2 == 0:
+    if stops_injected(index):
         schedule = stop_schedule(
             rng, primary, config.stop_gap_s, config.stop_duration_s, config.schedule_horizon_s
         )

@@ -1,0 +1,305 @@
+"""What the ego perceives each step: its leader, the next light, the next busy crossing, and
+the paper's 8-dim observation built from them.
+
+Each sensor is a small object that reads the running simulation and returns a value; none
+writes episode state. :class:`Perception` combines them into a :class:`Percept`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import traci.constants as tc
+from numpy.typing import NDArray
+
+from explaindrive.commands import Command
+from explaindrive.env import state as S
+from explaindrive.env.lights import AmberDecision
+from explaindrive.sim.crossing_lanes import CrossingLane, pedestrian_in_lane
+from explaindrive.sim.pedestrians import KerbYield
+from explaindrive.sim.route import RouteCrossing, RouteGeometry, RouteLight
+
+JUDGE_CROSSING_M = S.MAX_SPEED_MPS + 5.0  # [m] a crossing this close may be entered next step
+_LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
+_HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
+
+
+@dataclass(frozen=True, slots=True)
+class Leader:
+    """What the ego follows: a vehicle, or a zero-length virtual one at a stop line."""
+
+    gap_m: float
+    speed_mps: float
+    length_m: float
+    virtual: bool
+
+
+@dataclass(frozen=True, slots=True)
+class LightReading:
+    """The next light of the ego's route within sensor range.
+
+    Attributes:
+        gap_m: from the ego's front to its stop line (sensor range: none).
+        colour: its colour for the ego (green when none is in range).
+        light_id: its traffic light id (``None``: none in range).
+    """
+
+    gap_m: float = S.SENSOR_RANGE_M
+    colour: S.LightState = S.LightState.GREEN
+    light_id: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class CrossingReading:
+    """The crossings ahead.
+
+    Attributes:
+        gap_m: to the nearest one a pedestrian is on or entering (sensor range: none).
+        in_lane: crossing edge -> a pedestrian is in, or stepping into, the ego's lane there
+            (for the crossings in range; judged only near enough to be entered next step).
+    """
+
+    gap_m: float
+    in_lane: dict[str, bool]
+
+
+@dataclass(frozen=True, slots=True)
+class Percept:
+    """One step's perception.
+
+    Attributes:
+        obs: the raw observation (clipped to the state bounds).
+        leader: the effective leader (real or virtual), ``None`` if none in range.
+        real: the real leader, ``None`` if none in range.
+        lane_id: the ego's lane where SUMO changes its lanes (else ``None``).
+        crossings: the crossings ahead.
+    """
+
+    obs: NDArray[np.float32]
+    leader: Leader | None
+    real: Leader | None
+    lane_id: str | None
+    crossings: CrossingReading
+
+
+class LeaderSensor:
+    """The vehicle ahead in the ego's lane within sensor range (bumper-to-bumper gap).
+
+    Args:
+        ego_min_gap_m: the ego's minGap, which SUMO subtracts from leader gaps [m].
+        lengths: a cache of vehicle lengths by id, shared across episodes.
+    """
+
+    def __init__(self, ego_min_gap_m: float, lengths: dict[str, float]) -> None:
+        self.ego_min_gap_m = ego_min_gap_m
+        self._lengths = lengths
+
+    def __call__(self, api: Any, ego: Any) -> Leader | None:
+        """The real leader from the ego's subscription results ``ego``."""
+        lead = ego.get(tc.VAR_LEADER)
+        gap = float(lead[1]) + self.ego_min_gap_m if lead and lead[0] else S.SENSOR_RANGE_M
+        if gap >= S.SENSOR_RANGE_M:
+            return None
+        lid = lead[0]
+        length = self._lengths.get(lid)
+        if length is None:
+            length = self._lengths[lid] = float(api.vehicle.getLength(lid))
+        return Leader(max(gap, 0.0), float(api.vehicle.getSpeed(lid)), length, False)
+
+
+class LightSensor:
+    """The lights of the ego's route and the colours they show it.
+
+    Args:
+        lights: the route's lights, in route order.
+        tls_link: traffic light id -> the ego's link index there at entry.
+    """
+
+    def __init__(self, lights: tuple[RouteLight, ...], tls_link: dict[str, int]) -> None:
+        self.lights = lights
+        self.tls_link = tls_link
+
+    def colour(self, api: Any, light: RouteLight, lane_id: str | None) -> S.LightState:
+        """The colour ``light`` shows the ego: the link from the lane it is on when that lane
+        approaches the light, else the one it was routed through at entry."""
+        index = light.link_of(lane_id) if lane_id is not None else None
+        link = self.tls_link[light.tls_id] if index is None else index
+        states = api.trafficlight.getSubscriptionResults(light.tls_id)
+        return S.LightState.from_sumo(states[tc.TL_RED_YELLOW_GREEN_STATE][link])
+
+    def __call__(self, api: Any, pos_m: float, lane_id: str | None) -> LightReading:
+        """The next light ahead of route position ``pos_m`` (within sensor range)."""
+        for light in self.lights:
+            ahead = light.stop_line_m - pos_m
+            if ahead < 0.0 or light.tls_id not in self.tls_link:
+                continue
+            if ahead < S.SENSOR_RANGE_M:
+                return LightReading(ahead, self.colour(api, light, lane_id), light.tls_id)
+            break
+        return LightReading()
+
+
+class CrossingSensor:
+    """Pedestrians on, or about to step onto, the crossings of the ego's route.
+
+    Args:
+        crossings: the route's crossings.
+        lanes: crossing edge -> the ego lane's stretch on it.
+    """
+
+    def __init__(
+        self, crossings: tuple[RouteCrossing, ...], lanes: dict[str, CrossingLane]
+    ) -> None:
+        self.crossings = crossings
+        self.lanes = lanes
+
+    @staticmethod
+    def persons(api: Any, edge: str) -> tuple[str, ...]:
+        """The pedestrians on ``edge`` this step (a subscribed crossing or walking area)."""
+        res = api.edge.getSubscriptionResults(edge)
+        return tuple(res.get(tc.LAST_STEP_PERSON_ID_LIST, ()))
+
+    def in_lane(self, api: Any, crossing: RouteCrossing, persons: tuple[str, ...]) -> bool:
+        """Whether one of ``persons`` is in, or stepping into, the ego's lane on ``crossing``."""
+        lane = self.lanes[crossing.crossing_edge]
+        return any(pedestrian_in_lane(api, lane, pid) for pid in persons)
+
+    def occupied(
+        self, api: Any, crossing: RouteCrossing, kerb: KerbYield, on_it: bool, judge: bool
+    ) -> tuple[bool, bool]:
+        """(busy, in_lane): a pedestrian is on the crossing or, at a zebra, about to
+        step onto it; and whether one is in, or stepping into, the ego's lane on it
+        (looked at only with ``judge``: the ego is close enough to cross the line next).
+
+        At a signalized crossing pedestrians waiting on the kerb wait for their own
+        green, and once the ego is on the crossing (``on_it``) those on the kerb wait for
+        it, so then only pedestrians already on the crossing count. At a zebra, those
+        waiting for the ego (``kerb``) do not.
+        """
+        on_crossing = self.persons(api, crossing.crossing_edge)
+        if on_crossing:
+            return True, judge and self.in_lane(api, crossing, on_crossing)
+        if crossing.signalized or on_it:
+            return False, False
+        entering = tuple(
+            pid
+            for wa in crossing.walkingareas
+            for pid in self.persons(api, wa)
+            if api.person.getNextEdge(pid) == crossing.crossing_edge and not kerb.holds(pid)
+        )
+        return bool(entering), judge and bool(entering) and self.in_lane(api, crossing, entering)
+
+    def __call__(self, api: Any, pos_m: float, kerb: KerbYield) -> CrossingReading:
+        """The crossings ahead of route position ``pos_m``.
+
+        A crossing counts from sensor range until the ego's front has left the junction: a
+        car stopped on the crossing (e.g. by a STOP command) must not roll into pedestrians.
+        """
+        gap_m = S.SENSOR_RANGE_M
+        in_lane: dict[str, bool] = {}
+        for crossing in self.crossings:
+            ahead = crossing.stop_line_m - pos_m
+            if crossing.stop_line_m - crossing.end_m <= ahead < S.SENSOR_RANGE_M:
+                busy, in_lane[crossing.crossing_edge] = self.occupied(
+                    api, crossing, kerb, on_it=ahead < 0.0, judge=ahead < JUDGE_CROSSING_M
+                )
+                if busy:
+                    gap_m = min(gap_m, max(ahead, 0.0))
+        return CrossingReading(gap_m, in_lane)
+
+
+def effective_leader(
+    real: Leader | None, light_line: bool, light_gap_m: float, crossing_gap_m: float
+) -> Leader | None:
+    """The nearest of the real leader, the stop line of a light that is a virtual leader
+    (``light_line``) and a busy crossing in range."""
+    leader = real
+    if light_line and (leader is None or light_gap_m < leader.gap_m):
+        leader = Leader(max(light_gap_m, 0.0), 0.0, 0.0, True)
+    if crossing_gap_m < S.SENSOR_RANGE_M and (leader is None or crossing_gap_m < leader.gap_m):
+        leader = Leader(crossing_gap_m, 0.0, 0.0, True)
+    return leader
+
+
+def observation(
+    command: Command,
+    speed_mps: float,
+    posted_limit_mps: float,
+    leader: Leader | None,
+    light: LightReading,
+    crossing_gap_m: float,
+) -> NDArray[np.float32]:
+    """The paper's 8-dim raw observation (:mod:`explaindrive.env.state`), clipped to its
+    bounds."""
+    rng = S.SENSOR_RANGE_M
+    values = (
+        float(command),
+        speed_mps,
+        posted_limit_mps,
+        leader.gap_m if leader else rng,
+        (speed_mps - leader.speed_mps) if leader else 0.0,
+        light.gap_m,
+        float(light.colour),
+        crossing_gap_m,
+    )
+    # clipped in Python (the bounds are float32 values, so rounding afterwards gives the
+    # same result as clipping the float32 array): cheaper than two numpy calls
+    return np.array(
+        [min(max(x, lo), hi) for x, lo, hi in zip(values, _LOW, _HIGH, strict=True)],
+        dtype=np.float32,
+    )
+
+
+class Perception:
+    """The ego's sensors on one network for one entry of the ego.
+
+    Args:
+        geometry: the route's geometry.
+        crossing_lanes: crossing edge -> the ego lane's stretch on it.
+        leaders: the leader sensor.
+        tls_link: traffic light id -> the ego's link index there at entry.
+    """
+
+    def __init__(
+        self,
+        geometry: RouteGeometry,
+        crossing_lanes: dict[str, CrossingLane],
+        leaders: LeaderSensor,
+        tls_link: dict[str, int],
+    ) -> None:
+        self.geometry = geometry
+        self.leaders = leaders
+        self.lights = LightSensor(geometry.lights, tls_link)
+        self.crossings = CrossingSensor(geometry.crossings, crossing_lanes)
+
+    def __call__(
+        self,
+        api: Any,
+        ego: Any,
+        pos_m: float,
+        command: Command,
+        amber: AmberDecision,
+        kerb: KerbYield,
+    ) -> Percept:
+        """What the ego perceives at route position ``pos_m``.
+
+        Args:
+            api: the running simulation.
+            ego: the ego's subscription results of the current step.
+            pos_m: the ego's front along its route [m].
+            command: the active command.
+            amber: the decision at yellow (updated when a yellow is first seen).
+            kerb: the pedestrians waiting for the ego at a zebra.
+        """
+        v = float(ego[tc.VAR_SPEED])
+        lane_id = ego.get(tc.VAR_LANE_ID)
+        real = self.leaders(api, ego)
+        light = self.lights(api, pos_m, lane_id)
+        at_line = amber.is_leader(light.light_id, light.colour, v, light.gap_m)
+        crossings = self.crossings(api, pos_m, kerb)
+        leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m)
+        limit = self.geometry.posted_limit(pos_m)
+        obs = observation(command, v, limit, leader, light, crossings.gap_m)
+        return Percept(obs, leader, real, lane_id, crossings)

@@ -1,0 +1,88 @@
+"""The ego's violations in one step: collision, red-light run, pedestrian yield, speeding.
+
+Red lights and crossings are judged on what the ego saw before the step's observation: a
+violation is crossing a stop line during the step while the light was red, or while a
+pedestrian was in, or stepping into, the ego's lane on the crossing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from explaindrive.env.perception import CrossingSensor, LightSensor
+from explaindrive.env.state import LightState
+from explaindrive.sim.scenario.files import EGO_ID
+
+SPEEDING_TOLERANCE_MPS = 1e-6  # [m/s] above the legal limit by more than this is speeding
+
+
+def ego_collided(api: Any) -> bool:
+    """Whether the ego is in one of the collisions SUMO reported this step."""
+    return any(EGO_ID in (col.collider, col.victim) for col in api.simulation.getCollisions())
+
+
+def speeding(speed_mps: float, legal_limit_mps: float) -> bool:
+    """Whether ``speed_mps`` is above the legal limit."""
+    return speed_mps > legal_limit_mps + SPEEDING_TOLERANCE_MPS
+
+
+@dataclass(frozen=True, slots=True)
+class Violations:
+    """The stop-line violations of one step."""
+
+    red_light_run: bool
+    ped_violation: bool
+
+
+class ViolationJudge:
+    """Judges the ego's passage over the stop lines of its route.
+
+    Args:
+        lights: the light sensor of the episode (the colours the ego's links show).
+        crossings: the crossing sensor of the episode.
+    """
+
+    def __init__(self, lights: LightSensor, crossings: CrossingSensor) -> None:
+        self.lights = lights
+        self.crossings = crossings
+
+    def __call__(
+        self,
+        api: Any,
+        prev_pos_m: float,
+        pos_m: float,
+        lane_id: str | None,
+        in_lane: dict[str, bool],
+    ) -> Violations:
+        """The violations of a step that moved the ego's front from ``prev_pos_m`` to
+        ``pos_m`` (route positions [m]); ``lane_id`` and ``in_lane`` are what the ego
+        perceived before the step (:class:`~explaindrive.env.perception.Percept`)."""
+        return Violations(
+            self.ran_red_light(api, prev_pos_m, pos_m, lane_id),
+            self.crossed_occupied(api, prev_pos_m, pos_m, in_lane),
+        )
+
+    def ran_red_light(self, api: Any, prev_pos_m: float, pos_m: float, lane_id: str | None) -> bool:
+        """The ego's front crossed a stop line during this step while the light was red.
+
+        SUMO switches signals at the start of a step and then moves the cars, so the
+        colour read after the step is the one that held while the ego crossed.
+        """
+        for light in self.lights.lights:
+            if prev_pos_m < light.stop_line_m <= pos_m and light.tls_id in self.lights.tls_link:
+                return self.lights.colour(api, light, lane_id) is LightState.RED
+        return False
+
+    def crossed_occupied(
+        self, api: Any, prev_pos_m: float, pos_m: float, in_lane: dict[str, bool]
+    ) -> bool:
+        """The ego's front crossed a crossing's stop line during this step while a
+        pedestrian was in, or stepping into, its lane (before or after the step)."""
+        for crossing in self.crossings.crossings:
+            if prev_pos_m < crossing.stop_line_m <= pos_m:
+                on_crossing = self.crossings.persons(api, crossing.crossing_edge)
+                return in_lane.get(crossing.crossing_edge, False) or (
+                    bool(on_crossing) and self.crossings.in_lane(api, crossing, on_crossing)
+                )
+        return False

@@ -1,0 +1,62 @@
+"""Episode bookkeeping and a step's reward features and info, computed by hand."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+
+from explaindrive.commands import Command
+from explaindrive.env.episode import Episode, StepRecord
+from explaindrive.env.perception import Leader
+from explaindrive.env.reward import RECIPES, reward_terms
+from explaindrive.env.sumo_process import Motion
+from explaindrive.env.violations import Violations
+
+
+def episode(schedule: list[tuple[float, Command]]) -> Episode:
+    nothing: Any = None
+    return Episode(Command.FAST, schedule, 10.0, perception=nothing, judge=nothing)
+
+
+def test_scheduled_commands_switch_when_due() -> None:
+    ep = episode([(2.0, Command.STOP), (2.0, Command.COMFORT), (5.0, Command.FAST)])
+    ep.apply_schedule()
+    assert ep.command is Command.FAST
+    ep.steps = 2
+    ep.apply_schedule()  # both switches at 2 s apply, the later one wins
+    assert ep.command is Command.COMFORT and ep.schedule == [(5.0, Command.FAST)]
+    assert ep.time_s == 2.0
+
+
+def step(leader: Leader | None, real: Leader | None) -> StepRecord:
+    motion = Motion(10.0, collided=False, arrived=False, ego=None)
+    return StepRecord(Command.FAST, 1, 1.0, -0.5, motion, leader, real, 13.89,
+                      Violations(red_light_run=True, ped_violation=False))  # fmt: skip
+
+
+def test_features_are_taken_to_the_effective_leader() -> None:
+    real = Leader(30.0, 6.0, 5.0, False)
+    rec = step(Leader(20.0, 0.0, 0.0, True), real)
+    f = rec.features()
+    assert f.ttc_s == pytest.approx(2.0)  # 20 m closing at 10 m/s
+    assert f.headway_s == pytest.approx(2.0)  # a zero-length leader 20 m ahead at 10 m/s
+    assert f.real_headway_s == pytest.approx((30.0 + 5.0) / 10.0)
+    assert f.violation and f.stop_reason is None and f.closing_speed_mps == 10.0
+    assert step(None, None).features().ttc_s == math.inf
+
+
+def test_the_info_reports_the_step() -> None:
+    ep = episode([])
+    ep.steps, ep.pos_m = 4, 52.0
+    rec = step(None, Leader(30.0, 6.0, 5.0, False))
+    obs = np.array([0, 10, 13.89, 30, 4, 80, 2, 200], dtype=np.float32)
+    terms = reward_terms(Command.FAST, rec.features(), RECIPES["paper"])
+    info = rec.info(ep, obs, 13.89, terms)
+    assert info["time_s"] == 4.0 and info["distance_m"] == 42.0
+    assert info["real_ttc_s"] == pytest.approx(30.0 / 4.0)
+    assert info["light_state"] == "red" and info["light_gap_m"] == 80.0
+    assert info["red_light_run"] and not info["ped_violation"] and not info["speeding"]
+    assert info["gap_m"] == math.inf and info["reward_terms"] == terms.as_dict()
