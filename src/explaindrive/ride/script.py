@@ -20,8 +20,9 @@ from pathlib import Path
 from typing import Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
+from explaindrive.config import LaxModel
 from explaindrive.validation import describe_errors
 
 AUDIO_PREFIX = "@audio:"  # a typed passenger line that names a recorded audio file
@@ -31,10 +32,8 @@ class ScriptError(ValueError):
     """A ride script cannot be read or is invalid."""
 
 
-class ScriptLine(BaseModel):
+class ScriptLine(LaxModel):
     """One timed passenger line."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     t: float = Field(ge=0, description="ride time [s] at which the passenger speaks")
     say: str | None = None

@@ -28,7 +28,7 @@ from typing import Any
 
 from fastapi import FastAPI, HTTPException, Request, WebSocket, WebSocketDisconnect
 from fastapi.exceptions import RequestValidationError
-from fastapi.responses import FileResponse, JSONResponse
+from fastapi.responses import HTMLResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from starlette.datastructures import UploadFile
 from starlette.exceptions import HTTPException as StarletteHTTPException
@@ -54,11 +54,11 @@ from explaindrive.web.manager import (
     SessionFactory,
 )
 from explaindrive.web.models import AnswerRequest, SayRequest, StartRequest
+from explaindrive.web.page import STATIC_DIR, render_page
 from explaindrive.web.scene import load_scene
 
 log = logging.getLogger(__name__)
 
-STATIC_DIR = Path(__file__).parent / "static"
 MAX_UPLOAD_BYTES = 5 * 1024 * 1024  # [B] about five minutes of Opus, 50 s of 16-bit WAV
 MAX_JSON_BYTES = 16 * 1024  # [B] request bodies other than uploads (a request is 300 chars)
 MULTIPART_OVERHEAD_BYTES = 16 * 1024  # [B] boundaries and part headers around an upload
@@ -217,8 +217,8 @@ def _add_read_routes(app: FastAPI, manager: RideManager, scene: Any) -> None:
     """The page, the scene and the status."""
 
     @app.get("/", include_in_schema=False)
-    async def index() -> FileResponse:
-        return FileResponse(STATIC_DIR / "index.html", media_type="text/html")
+    async def index() -> HTMLResponse:
+        return HTMLResponse(render_page())
 
     @app.get("/api/scene")
     async def get_scene() -> dict[str, Any]:

@@ -38,10 +38,14 @@ Listener = Callable[[dict[str, Any]], None]
 
 LOG_LIMIT = 200  # passenger events kept for pages that join late
 EXPLANATION_SCAN_STEPS = 30  # explanations attach to earlier steps; look this far back
-INTERPRET_DEADLINE_S = 8.0  # [s] a paced ride never waits on language; Whisper on CPU is slow
 COMMAND_TIMEOUT_S = 300.0  # [s] the first start loads the models
 MAX_WAITING_UPLOADS = 4  # recordings stored and not yet transcribed
 UPLOAD_GRACE_S = 2.0  # [s] kept past the transcription deadline before a sweep deletes it
+PAGE_INTERPRET_DEADLINE_S = RideConfig().audio_deadline_s
+"""[s] The typed-request deadline of a ride on the page. That ride is paced and never waits
+on language, so a typed request is given as long as a spoken one
+(:attr:`RideConfig.audio_deadline_s`); a terminal ride fast-forwards and pauses for a typed
+request at most :attr:`RideConfig.interpret_deadline_s`."""
 
 
 class RideState(StrEnum):
@@ -221,7 +225,7 @@ class RideManager:
             seed=settings.seed,
             max_steps=settings.max_steps,
             realtime=True,
-            interpret_deadline_s=INTERPRET_DEADLINE_S,
+            interpret_deadline_s=PAGE_INTERPRET_DEADLINE_S,
         )
         with self._lock:
             self._ride += 1
