@@ -32,8 +32,9 @@ from explaindrive.jsonsafe import finite
 from explaindrive.language.intent import parse_confirmation_answer
 from explaindrive.redact import redact, redact_json
 from explaindrive.ride.plot import plot_ride
+from explaindrive.ride.records import StepRecord
 from explaindrive.ride.script import AUDIO_PREFIX, ScriptLine
-from explaindrive.ride.session import RideSession, StepRecord
+from explaindrive.ride.session import RideSession
 
 log = logging.getLogger(__name__)
 
