@@ -3,19 +3,21 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import yaml
-from pydantic import Field
+from pydantic import AfterValidator, Field
 
 from explaindrive.config import LaxModel, read_yaml
+from explaindrive.language.backends.registry import check_backend
 from explaindrive.language.encoders import (
     DEFAULT_RUNTIME,
     EncoderRuntime,
     check_runtime,
 )
 
-BackendName = Literal["embedded", "openai"]
+BackendName = Annotated[str, AfterValidator(check_backend)]
+"""The name of a registered language backend (:mod:`explaindrive.language.backends`)."""
 
 SUMMARY_CUTOFF_M = 50.0  # [m] objects farther than this are left out of summaries and decisions
 
