@@ -37,6 +37,7 @@ from explaindrive.language.config import LanguageConfig
 from explaindrive.limits import MAX_SEED
 from explaindrive.redact import redact
 from explaindrive.ride.config import RideConfig
+from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
 from explaindrive.ride.runner import (
     OutputDirError,
     StopRequest,
@@ -45,7 +46,6 @@ from explaindrive.ride.runner import (
     prepare_out_dir,
 )
 from explaindrive.ride.script import (
-    AUDIO_PREFIX,
     ScriptError,
     ScriptLine,
     default_script_path,
@@ -266,7 +266,7 @@ def _run(
     lines: list[ScriptLine],
     staging: Path,
     out: Path,
-    typed: queue.Queue[str] | None,
+    typed: queue.Queue[PassengerInput | str] | None,
     live: bool,
 ) -> RideOutputs:
     """Run the ride into ``staging``, then move it into ``out`` if it drove at least one
@@ -314,10 +314,10 @@ def _run(
     )
 
 
-def _passenger_input(voice: bool) -> queue.Queue[str]:
+def _passenger_input(voice: bool) -> queue.Queue[PassengerInput | str]:
     """Start reading the passenger's typed (or, with ``voice``, spoken) requests in the
     background; returns the queue they arrive in."""
-    typed: queue.Queue[str] = queue.Queue()
+    typed: queue.Queue[PassengerInput | str] = queue.Queue()
 
     def read() -> None:
         from explaindrive.ride.microphone import MicrophoneUnavailableError, record
@@ -328,11 +328,11 @@ def _passenger_input(voice: bool) -> queue.Queue[str]:
                     path = record()
                 except MicrophoneUnavailableError as exc:
                     console.print(f"[yellow]{exc}[/yellow]; the typed text is used instead")
-                    typed.put(line)
+                    typed.put(TypedLine(line))
                     continue
-                typed.put(f"{AUDIO_PREFIX}{path}")
+                typed.put(SpokenLine(path))
             else:
-                typed.put(line)
+                typed.put(TypedLine(line))
 
     if voice:
         console.print("press Enter to speak (4 s), or type a request")

@@ -30,6 +30,7 @@ from explaindrive.language.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
 from explaindrive.ride.explaining import Explanations
+from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
 from explaindrive.ride.jobs import DecideJob, ExplainJob, InterpretJob
 from explaindrive.ride.lane import LanguageLane, Outcome, TaskKind
 from explaindrive.ride.records import PassengerRequest, RideCounts, StepRecord
@@ -148,6 +149,14 @@ class RideSession:
     def say_audio(self, path: str | Path, confirm: str | None = None) -> int:
         """A spoken passenger line (a WAV/FLAC/MP3 file); returns its request id."""
         return self.requests.submit(text=None, audio=Path(path), confirm=confirm)
+
+    def hear(self, line: PassengerInput, confirm: str | None = None) -> int:
+        """A passenger line, typed or spoken; returns its request id."""
+        match line:
+            case TypedLine(text):
+                return self.say(text, confirm=confirm)
+            case SpokenLine(audio):
+                return self.say_audio(audio, confirm=confirm)
 
     def answer(self, yes: bool) -> bool:
         """Answer the pending confirmation question; ``False`` if none was pending."""
