@@ -227,14 +227,15 @@ def seed_run_args(
 def _train_seeds(
     mode: str, seeds_text: str, seed: int | None, out: Path | None, train_args: list[str]
 ) -> None:
-    """``--seeds``: one run per seed, then the combined table (:mod:`explaindrive.agent.sweep`)."""
-    from explaindrive.agent.sweep import (
+    """``--seeds``: one run per seed, then the combined table
+    (:mod:`explaindrive.evaluation.sweep`)."""
+    from explaindrive.evaluation.spec import SpecError, parse_seeds
+    from explaindrive.evaluation.sweep import (
         DEFAULT_EVAL_SEEDS,
         DEFAULT_EVAL_STOPS,
         evaluate_seeds,
         train_seeds,
     )
-    from explaindrive.evaluation.spec import SpecError, parse_seeds
     from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
     try:
