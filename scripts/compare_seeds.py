@@ -15,13 +15,15 @@ from pathlib import Path
 
 from explaindrive.evaluation.seeds import evaluate_runs, seed_table
 from explaindrive.evaluation.spec import parse_levels, parse_seeds
+from explaindrive.evaluation.sweep import DEFAULT_EVAL_SEEDS
+from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("runs", nargs="+", help="training run directories or policy files")
-    parser.add_argument("--seeds", default="1000-1009")
-    parser.add_argument("--traffic", default="0.5,0.75,1.0,1.25,1.5")
+    parser.add_argument("--seeds", default=DEFAULT_EVAL_SEEDS)
+    parser.add_argument("--traffic", default=",".join(f"{x:g}" for x in TRAFFIC_LEVELS))
     parser.add_argument("--stop-schedule", default=None)
     parser.add_argument("--shield", action="store_true", help="evaluate with the shield on")
     parser.add_argument("--workers", type=int, default=None)

@@ -11,6 +11,13 @@ from pathlib import Path
 import pytest
 
 from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.language.backends import (
+    Backend,
+    LanguageModules,
+    register_backend,
+    unregister_backend,
+)
+from explaindrive.language.config import LanguageConfig
 
 MODEL_FIXTURES = frozenset({"interpreter", "transcriber", "speak"})
 MODEL_MODULES = frozenset({
@@ -84,3 +91,24 @@ def netgen(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., Path]:
 GRID_WITH_LIGHTS = ("--grid.number", "5", "--grid.length", "200",
                     "--default-junction-type", "traffic_light")  # fmt: skip
 """A 5x5 grid of 200 m blocks whose junctions all have lights."""
+
+
+class FakeBackend(Backend):
+    """A third language backend, as a plug-in would add one: keyword matching, a decider
+    that explains braking, an explainer that echoes; no model and no network."""
+
+    name = "fake"
+    description = "keywords, no model"
+
+    def build(self, config: LanguageConfig) -> LanguageModules:
+        from tests.ride.fakes import BrakingDecider, EchoExplainer, KeywordInterpreter
+
+        return LanguageModules(KeywordInterpreter(), BrakingDecider(), EchoExplainer())
+
+
+@pytest.fixture
+def fake_backend() -> Iterator[str]:
+    """The ``fake`` backend registered for one test; yields its name."""
+    register_backend(FakeBackend)
+    yield FakeBackend.name
+    unregister_backend(FakeBackend.name)

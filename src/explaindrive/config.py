@@ -7,8 +7,9 @@ takes only integers (``2.0``, ``"2"`` and ``true`` are errors), a float field ta
 integers and floats, a flag only ``true``/``false`` and a text field only text. Tuples
 are given as lists in JSON and YAML (:data:`FROM_LIST`) and paths as text (:data:`TextPath`).
 
-:class:`ConfigModel` adds what the run settings (training, env, ride) share: a
-:class:`ConfigError` whose one line names every bad key (:func:`config_error`),
+:class:`LaxModel` keeps every rule but converts values as pydantic's lax mode does, for
+input written by hand. :class:`ConfigModel` adds what the run settings (training, env, ride)
+share: a :class:`ConfigError` whose one line names every bad key (:func:`config_error`),
 :meth:`~ConfigModel.from_dict`, a validated :meth:`~ConfigModel.replace` and JSON-ready
 :meth:`~ConfigModel.to_dict`. :data:`TrafficLevel` and :data:`Seed` check a value against
 the scenario's one definition of its range (:mod:`explaindrive.sim.scenario.limits`).
@@ -55,6 +56,15 @@ class StrictModel(BaseModel):
         validate_default=True,
         use_attribute_docstrings=True,
     )
+
+
+class LaxModel(StrictModel):
+    """A :class:`StrictModel` whose values are converted as pydantic's lax mode does: paths
+    and numbers given as text, ``2.0`` for an integer. For input a person writes by hand (a
+    language config, a ride script, a request body); the other rules are :class:`StrictModel`'s.
+    """
+
+    model_config = ConfigDict(strict=False)
 
 
 class ConfigModel(StrictModel):

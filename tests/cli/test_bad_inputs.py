@@ -1,4 +1,4 @@
-"""Bad input to the CLI ends in one line and exit status 2, never a traceback.
+"""Bad input to the CLI ends in one line on stderr and exit status 2, never a traceback.
 
 Each case runs the real ``explaindrive`` command in a subprocess with a 50-column
 terminal, so a long message that wrapped would show as two lines.
@@ -30,8 +30,10 @@ def run(*args: str, cwd: Path, timeout_s: float = 120) -> subprocess.CompletedPr
 
 
 def one_error_line(res: subprocess.CompletedProcess[str]) -> str:
-    lines = (res.stdout + res.stderr).strip().splitlines()
+    """The one error line on stderr (stdout stays empty: errors never go there)."""
+    lines = res.stderr.strip().splitlines()
     assert res.returncode == 2, res.stdout + res.stderr
+    assert res.stdout == "", res.stdout
     assert len(lines) == 1 and lines[0].startswith("error: "), lines
     assert "Traceback" not in res.stdout + res.stderr
     return lines[0]

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
+import typer
 from rich.console import Console
 
 from explaindrive.cli._errors import error_line
@@ -26,3 +30,40 @@ def test_help_shows_the_units_in_brackets() -> None:
     assert "Stop injections [s], e.g. 60-75,150-165." in " ".join(
         runner.invoke(app, ["evaluate", "--help"]).output.split()
     )
+
+
+def test_error_lines_go_to_stderr_and_refuse_exits_with_the_code(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from explaindrive.cli import _errors
+
+    with pytest.raises(typer.Exit) as exit_info:
+        _errors.refuse("no such file: x.yaml", code=3)
+    assert exit_info.value.exit_code == 3
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == "error: no such file: x.yaml\n"
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["scenario", "plot", "--net", "missing.net.xml", "--out", "n.png"], "network file"),
+        (["scenario", "build", "--set", "lanes=2"], "--set needs --out DIR"),
+        (["interpret"], "give either TEXT or --audio FILE"),
+        (["transcribe", "missing.wav"], "missing.wav"),
+        (["demo", "--command", "faster"], "faster"),
+    ],
+)
+def test_every_subcommand_writes_its_error_on_stderr(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, args: list[str], message: str
+) -> None:
+    from typer.testing import CliRunner
+
+    from explaindrive.cli.main import app
+
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2, result.output
+    assert result.stdout == ""
+    assert result.stderr.startswith("error: ") and message in result.stderr

@@ -79,3 +79,15 @@ def test_a_script_that_is_not_utf8_names_the_file(tmp_path):
         str(err.value)
         == f"ride script {path} is not UTF-8 text (byte 42: invalid continuation byte)"
     )
+
+
+def test_a_line_is_typed_or_spoken_never_a_prefixed_string(tmp_path: Path) -> None:
+    from explaindrive.ride.inputs import SpokenLine, TypedLine
+
+    (tmp_path / "stop.wav").write_bytes(b"RIFF")
+    (tmp_path / "s.yaml").write_text(
+        "- {t: 0, say: '@audio:stop.wav'}\n- {t: 5, audio: stop.wav}\n"
+    )
+    typed, spoken = load_script(tmp_path / "s.yaml")
+    assert typed.line == TypedLine("@audio:stop.wav")  # text stays text
+    assert spoken.line == SpokenLine(tmp_path / "stop.wav")

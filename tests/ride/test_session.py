@@ -135,6 +135,23 @@ def test_typed_yes_waits_for_its_question(tmp_path):
     assert session.records[-1].command == "stop"
 
 
+def test_spoken_and_typed_lines_arrive_typed(tmp_path):
+    """Interactive input: a recording is transcribed; text that looks like a file name is
+    read as text."""
+    import queue
+
+    from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
+
+    lines: queue.Queue[PassengerInput | str] = queue.Queue()
+    lines.put(SpokenLine(tmp_path / "please_stop.wav"))
+    lines.put(TypedLine("@audio:hurry.wav"))
+    session = make_session(max_steps=10, auto_confirm=True)
+    run_ride(session, [], tmp_path / "ride", typed=lines)
+    assert [e["text"] for e in events(session, "line")] == [None, "@audio:hurry.wav"]
+    assert [e["text"] for e in events(session, "transcript")] == ["please stop"]
+    assert session.counts.requests == 2
+
+
 def test_a_later_request_understood_first_wins():
     """'hurry (slow model)' then 'stop': the stop is read first; the older fast is dropped."""
     session = make_session(realtime=True, max_steps=20)

@@ -4,7 +4,7 @@ Each actor holds one :class:`~explaindrive.agent.rollout.RolloutWorker` (one SUM
 simulation, as libsumo requires); the learner stays on the driver. The weights of a round go
 into the object store once and every actor reads them from there. An actor that dies is
 restarted by Ray (``max_restarts=-1``); the round it was playing comes back as
-:class:`~explaindrive.agent.workers.WorkerLost`. Ray is the optional extra
+:class:`~explaindrive.agent.pool.WorkerLost`. Ray is the optional extra
 ``explaindrive[ray]``.
 """
 
@@ -22,8 +22,8 @@ from types import ModuleType
 from typing import Any
 
 from explaindrive.agent.config import ConfigError, TrainConfig
+from explaindrive.agent.pool import RoundResult, WorkerLost
 from explaindrive.agent.rollout import CollectRequest, EnvFactory, Rollout, RolloutWorker
-from explaindrive.agent.workers import RoundResult, WorkerLost
 from explaindrive.limits import RAY_CONNECT_TIMEOUT_S
 
 log = logging.getLogger(__name__)

@@ -52,6 +52,7 @@ from explaindrive.agent.checkpoint import (
 )
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.learner import D3QNLearner
+from explaindrive.agent.pool import WorkerLost, WorkerPool
 from explaindrive.agent.rollout import CollectRequest, EnvFactory, Rollout, default_env_factory
 from explaindrive.agent.run_log import (
     CSV_FIELDS,
@@ -62,7 +63,7 @@ from explaindrive.agent.run_log import (
     tb_episode,
     truncate_csv,
 )
-from explaindrive.agent.workers import WorkerLost, WorkerPool, make_pool
+from explaindrive.agent.workers import make_pool
 
 log = logging.getLogger(__name__)
 

@@ -5,7 +5,8 @@ A pool takes one :class:`~explaindrive.agent.rollout.CollectRequest` per worker
 their :class:`~explaindrive.agent.rollout.Rollout` in worker order (:meth:`WorkerPool.gather`).
 A Ray actor that dies is restarted by Ray; its round comes back as :class:`WorkerLost` and
 the caller replays the episode it was playing. Local worker processes that die stop the run
-with an error naming the worker.
+with an error naming the worker. The types every pool shares are in
+:mod:`explaindrive.agent.pool`.
 """
 
 from __future__ import annotations
@@ -19,44 +20,15 @@ import signal
 import sys
 import traceback
 from collections.abc import Sequence
-from dataclasses import dataclass
 from multiprocessing.connection import Connection
-from typing import Any, Protocol
+from typing import Any
 
 from explaindrive.agent.config import TrainConfig
-from explaindrive.agent.rollout import CollectRequest, EnvFactory, Rollout, RolloutWorker
+from explaindrive.agent.pool import RoundResult, WorkerPool
+from explaindrive.agent.rollout import CollectRequest, EnvFactory, RolloutWorker
 from explaindrive.processes import children_ignore_sigint, restore_sigint
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class WorkerLost:
-    """A worker died during the round (it has been restarted without an episode)."""
-
-    worker: int
-    reason: str
-
-
-RoundResult = Rollout | WorkerLost
-
-
-class WorkerPool(Protocol):
-    """What the trainer needs from its workers."""
-
-    num_workers: int
-
-    def submit(self, requests: Sequence[CollectRequest]) -> None:
-        """Start one round: request ``i`` goes to worker ``i``."""
-        ...
-
-    def gather(self) -> list[RoundResult]:
-        """Wait for the round; one result per worker, in worker order."""
-        ...
-
-    def close(self) -> None:
-        """Stop the workers."""
-        ...
 
 
 class InProcessPool:

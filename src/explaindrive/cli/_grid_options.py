@@ -12,7 +12,7 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from explaindrive.cli._errors import error_line
+from explaindrive.cli._errors import print_error
 from explaindrive.limits import MAX_STEPS, MAX_WORKERS
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
@@ -49,6 +49,20 @@ JsonOption = Annotated[
 MaxStepsOption = Annotated[
     int, typer.Option("--max-steps", min=1, max=MAX_STEPS, help="Step limit per episode [s].")
 ]
+
+
+def obs_noise_sd(text: str | None) -> tuple[float, float]:
+    """``--obs-noise SD_M,SD_MPS`` as the config field ``(sd_m, sd_mps)``; no noise for ``None``.
+
+    Raises:
+        ValueError: naming the expected form or the accepted range.
+    """
+    if text is None:
+        return (0.0, 0.0)
+    from explaindrive.env.noise import parse_noise
+
+    noise = parse_noise(text)
+    return (noise.sd_m, noise.sd_mps)
 
 
 def check_ray_target(ray: bool, ray_address: str | None) -> str | None:
@@ -89,5 +103,5 @@ def episode_progress(description: str, total: int) -> Iterator[EpisodeProgress]:
             task = bar.add_task(description, total=total)
             yield lambda done, _total: bar.update(task, completed=done)
     except (CheckpointError, RuntimeError) as exc:
-        err_console.print(error_line(exc))
+        print_error(exc)
         raise typer.Exit(1) from None

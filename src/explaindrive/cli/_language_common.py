@@ -6,14 +6,12 @@ import json
 from pathlib import Path
 from typing import Any, NoReturn
 
-import typer
 from rich.console import Console
 
-from explaindrive.cli._errors import error_line
+from explaindrive.cli._errors import refuse
 from explaindrive.language.config import LanguageConfig
 
 console = Console()
-err_console = Console(stderr=True)
 
 BACKEND_HELP = "Language backend: embedded (offline, default) or openai."
 CONFIG_HELP = "YAML language config: backend, endpoint, model, key variable, timeouts."
@@ -41,9 +39,8 @@ def load_config(path: Path | None, model: str | None = None) -> LanguageConfig:
 
 
 def fail(message: str, code: int = 2) -> NoReturn:
-    """Print an error on stderr and exit."""
-    err_console.print(error_line(message), highlight=False, soft_wrap=True)
-    raise typer.Exit(code)
+    """Print an error on stderr and exit (:func:`~explaindrive.cli._errors.refuse`)."""
+    refuse(message, code)
 
 
 def emit_json(data: Any) -> None:

@@ -67,7 +67,6 @@ def refuse_bad_outputs(
     """Check each ``(path, flag)`` of ``files`` and ``folders``; the first problem ends the
     command with one line on stderr and exit status 2."""
     import typer
-    from rich.console import Console
 
     from explaindrive.cli._errors import print_error
 
@@ -77,5 +76,5 @@ def refuse_bad_outputs(
         for path, flag in folders:
             check_out_dir(path, flag)
     except OutputPathError as exc:
-        print_error(Console(stderr=True), exc)
+        print_error(exc)
         raise typer.Exit(2) from None

@@ -6,7 +6,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from explaindrive.cli._errors import error_line
+from explaindrive.cli._errors import print_error
 from explaindrive.commands import Command
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.metrics import EpisodeMetrics
@@ -26,7 +26,7 @@ def demo(
         cmd = Command.parse(command)
         env = UrbanDriveEnv(EnvConfig(traffic_level=traffic))
     except (ValueError, FileNotFoundError) as exc:
-        console.print(error_line(exc))
+        print_error(exc)
         raise typer.Exit(2) from exc
     driver = CautiousDriver()
     metrics = EpisodeMetrics()

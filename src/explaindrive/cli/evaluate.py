@@ -10,7 +10,7 @@ from rich.console import Console
 
 from explaindrive.cli import _grid_options as grid
 from explaindrive.cli import _scenario_options as where
-from explaindrive.cli._errors import error_line, print_error
+from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import err_console
 from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.evaluation.paper import PAPER_SEEDS
@@ -82,7 +82,6 @@ def evaluate_command(
     demand: where.DemandOption = None,
 ) -> None:
     """Evaluate a policy or a SUMO baseline; prints Markdown tables in the paper's layout."""
-    from explaindrive.env.noise import parse_noise
     from explaindrive.evaluation.schema import run_document, write_json
     from explaindrive.evaluation.spec import (
         parse_levels,
@@ -96,18 +95,17 @@ def evaluate_command(
         spec = parse_policy(
             policy, fast_path=fast_policy, comfort_path=comfort_policy, shield=shield
         )
-        noise = parse_noise(obs_noise) if obs_noise is not None else None
         plan = plan_run(
             spec, parse_seeds(seeds), parse_levels(traffic),
             stop_schedule=stop_schedule, commands=commands, max_steps=max_steps,
-            obs_noise=(noise.sd_m, noise.sd_mps) if noise else (0.0, 0.0),
+            obs_noise=grid.obs_noise_sd(obs_noise),
         )  # fmt: skip
         plan = _in_scenarios(plan, scenario, scenarios, net, route, demand)
     except (ValueError, where.ScenarioChoiceError) as exc:
-        print_error(err_console, exc)
+        print_error(exc)
         raise typer.Exit(2) from None
     if (problem := grid.check_ray_target(ray, ray_address)) is not None:
-        err_console.print(error_line(problem))
+        print_error(problem)
         raise typer.Exit(2)
     _check_policies(spec)
     records = _run(plan, workers, ray, ray_address)
@@ -180,7 +178,7 @@ def _check_policies(spec: PolicySpec) -> None:
         for path in spec.paths:
             load_policy(Path(path))
     except CheckpointError as exc:
-        err_console.print(error_line(exc))
+        print_error(exc)
         raise typer.Exit(2) from None
 
 

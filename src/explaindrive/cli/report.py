@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from explaindrive.cli import _grid_options as grid
-from explaindrive.cli._errors import error_line
+from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import err_console
 from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.evaluation.spec import POLICY_NAMES
@@ -138,7 +138,7 @@ def _plan(
             shield=shield,
         )  # fmt: skip
     except SpecError as exc:
-        err_console.print(error_line(exc))
+        print_error(exc)
         raise typer.Exit(2) from None
 
 

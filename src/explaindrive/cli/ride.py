@@ -29,14 +29,15 @@ from rich.console import Console
 from rich.live import Live
 
 from explaindrive.cli import _scenario_options as where
-from explaindrive.cli._errors import print_error
-from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
+from explaindrive.cli._errors import print_error, refuse
+from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption, obs_noise_sd
 from explaindrive.cli._language_common import read_config
 from explaindrive.cli._signals import HANDLED_SIGNALS, exit_status, handle_signals, signal_label
 from explaindrive.language.config import LanguageConfig
 from explaindrive.limits import MAX_SEED
 from explaindrive.redact import redact
 from explaindrive.ride.config import RideConfig
+from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
 from explaindrive.ride.runner import (
     OutputDirError,
     StopRequest,
@@ -45,7 +46,6 @@ from explaindrive.ride.runner import (
     prepare_out_dir,
 )
 from explaindrive.ride.script import (
-    AUDIO_PREFIX,
     ScriptError,
     ScriptLine,
     default_script_path,
@@ -57,6 +57,9 @@ if TYPE_CHECKING:
     from explaindrive.ride.session import RideSession
 
 console = Console()
+
+DEFAULTS = RideConfig()
+"""The ride settings' defaults, which the options' defaults are (one home: RideConfig)."""
 
 
 # What the passenger says, and how requests are confirmed
@@ -113,31 +116,21 @@ ForceOption = Annotated[
 LiveOption = Annotated[bool, typer.Option("--live/--no-live", help="Live terminal view.")]
 
 
-def _noise(text: str | None) -> tuple[float, float]:
-    """``--obs-noise`` as ``(sd_m, sd_mps)``; ValueError naming the expected form."""
-    if text is None:
-        return (0.0, 0.0)
-    from explaindrive.env.noise import parse_noise
-
-    noise = parse_noise(text)
-    return (noise.sd_m, noise.sd_mps)
-
-
 def ride(
     script: ScriptOption = None,
     interactive: InteractiveOption = False,
     voice: VoiceOption = False,
     backend: BackendOption = None,
-    traffic: TrafficOption = 1.0,
-    seed: SeedOption = 0,
-    gui: GuiOption = False,
-    realtime: RealtimeOption = False,
+    traffic: TrafficOption = DEFAULTS.traffic_level,
+    seed: SeedOption = DEFAULTS.seed,
+    gui: GuiOption = DEFAULTS.gui,
+    realtime: RealtimeOption = DEFAULTS.realtime,
     out: OutOption = Path("out/ride"),
     force: ForceOption = False,
-    auto_confirm: AutoConfirmOption = False,
-    stop_without_confirm: StopWithoutConfirmOption = False,
-    max_steps: MaxStepsOption = 600,
-    cooldown: CooldownOption = 15.0,
+    auto_confirm: AutoConfirmOption = DEFAULTS.auto_confirm,
+    stop_without_confirm: StopWithoutConfirmOption = DEFAULTS.stop_without_confirm,
+    max_steps: MaxStepsOption = DEFAULTS.max_steps,
+    cooldown: CooldownOption = DEFAULTS.explanation_cooldown_s,
     live: LiveOption = True,
     fast_policy: FastPolicyOption = None,
     comfort_policy: ComfortPolicyOption = None,
@@ -166,7 +159,7 @@ def ride(
             gui=gui,
             fast_policy=fast_policy,
             comfort_policy=comfort_policy,
-            obs_noise=_noise(obs_noise),
+            obs_noise=obs_noise_sd(obs_noise),
             **where.scenario_fields(scenario, net, route, demand),
         )
         lines = _script_lines(script, interactive, max_steps)
@@ -244,9 +237,8 @@ def _exit_unchanged(signum: int, out: Path) -> NoReturn:
 
 
 def _refuse(message: object) -> NoReturn:
-    """Print one error line and exit with status 2."""
-    print_error(console, message)
-    raise typer.Exit(2)
+    """Print one error line on stderr and exit with status 2."""
+    refuse(message)
 
 
 def _build_session(
@@ -274,7 +266,7 @@ def _run(
     lines: list[ScriptLine],
     staging: Path,
     out: Path,
-    typed: queue.Queue[str] | None,
+    typed: queue.Queue[PassengerInput | str] | None,
     live: bool,
 ) -> RideOutputs:
     """Run the ride into ``staging``, then move it into ``out`` if it drove at least one
@@ -306,7 +298,6 @@ def _run(
         where = commit_ride(staging, out).summary if kept else None
         discard_ride(staging)
         print_error(
-            console,
             redact(
                 f"the ride stopped on an error after {len(session.records)} s "
                 f"({type(exc).__name__}: {exc}); "
@@ -323,10 +314,10 @@ def _run(
     )
 
 
-def _passenger_input(voice: bool) -> queue.Queue[str]:
+def _passenger_input(voice: bool) -> queue.Queue[PassengerInput | str]:
     """Start reading the passenger's typed (or, with ``voice``, spoken) requests in the
     background; returns the queue they arrive in."""
-    typed: queue.Queue[str] = queue.Queue()
+    typed: queue.Queue[PassengerInput | str] = queue.Queue()
 
     def read() -> None:
         from explaindrive.ride.microphone import MicrophoneUnavailableError, record
@@ -337,11 +328,11 @@ def _passenger_input(voice: bool) -> queue.Queue[str]:
                     path = record()
                 except MicrophoneUnavailableError as exc:
                     console.print(f"[yellow]{exc}[/yellow]; the typed text is used instead")
-                    typed.put(line)
+                    typed.put(TypedLine(line))
                     continue
-                typed.put(f"{AUDIO_PREFIX}{path}")
+                typed.put(SpokenLine(path))
             else:
-                typed.put(line)
+                typed.put(TypedLine(line))
 
     if voice:
         console.print("press Enter to speak (4 s), or type a request")

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
-from explaindrive.cli._errors import error_line, print_error
+from explaindrive.cli._errors import print_error
 from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.sim.scenario.files import package_data_dir
 
@@ -34,12 +34,12 @@ def build(
         Console().print(f"network written to {net}")
         return
     if out is None:
-        print_error(Console(stderr=True), "--set needs --out DIR (the package's road stays)")
+        print_error("--set needs --out DIR (the package's road stays)")
         raise typer.Exit(2)
     try:
         params = ScenarioParams.from_settings(settings)
     except ConfigError as exc:
-        print_error(Console(stderr=True), exc)
+        print_error(exc)
         raise typer.Exit(2) from None
     write_scenario_dir(out, params, out.name)
     Console().print(f"scenario written to {out}")
@@ -57,7 +57,7 @@ def random(
     try:
         params = random_params(seed)
     except ValueError as exc:
-        print_error(Console(stderr=True), exc)
+        print_error(exc)
         raise typer.Exit(2) from None
     refuse_bad_outputs(folders=((out, "--out"),))
     write_scenario_dir(out, params, f"random-{seed}", seed)
@@ -75,7 +75,7 @@ def plot(
     refuse_bad_outputs(files=((out, "--out"),))
     net_file = net or package_data_dir() / "urban.net.xml"
     if not net_file.is_file():
-        Console().print(error_line(f"network file not found: {net_file}"))
+        print_error(f"network file not found: {net_file}")
         raise typer.Exit(2)
     Console().print(f"figure written to {plot_network(net_file, out)}")
 

@@ -62,7 +62,7 @@ def serve(
             MergedController.from_package(fast=fast_policy, comfort=comfort_policy)
         place = where.scenario_fields(scenario, net, route, demand)
     except (FileNotFoundError, ValueError, CheckpointError) as exc:
-        print_error(console, exc)
+        print_error(exc)
         raise typer.Exit(2) from exc
     hosts = served_hosts(host, allow_host)
     if host not in LOOPBACK_HOSTS:

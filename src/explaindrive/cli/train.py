@@ -155,7 +155,7 @@ def train_command(
     try:
         place = where.scenario_fields(scenario, net, route, demand, allow_random=True)
     except where.ScenarioChoiceError as exc:
-        print_error(console, exc)
+        print_error(exc)
         raise typer.Exit(2) from None
     if seeds is not None:
         run_args = seed_run_args(mode, episodes, envs, resume, preset, config_file,
@@ -175,7 +175,7 @@ def train_command(
         trainer = Trainer(config, out, resume=resume, show_progress=progress, use_ray=ray,
                           ray_address=ray_address)  # fmt: skip
     except (ConfigError, CheckpointError) as exc:
-        print_error(console, exc)
+        print_error(exc)
         raise typer.Exit(2) from None
     console.print(
         f"training [bold]{config.mode}[/bold]: {config.episodes} episodes on {config.envs} "
@@ -227,14 +227,15 @@ def seed_run_args(
 def _train_seeds(
     mode: str, seeds_text: str, seed: int | None, out: Path | None, train_args: list[str]
 ) -> None:
-    """``--seeds``: one run per seed, then the combined table (:mod:`explaindrive.agent.sweep`)."""
-    from explaindrive.agent.sweep import (
+    """``--seeds``: one run per seed, then the combined table
+    (:mod:`explaindrive.evaluation.sweep`)."""
+    from explaindrive.evaluation.spec import SpecError, parse_seeds
+    from explaindrive.evaluation.sweep import (
         DEFAULT_EVAL_SEEDS,
         DEFAULT_EVAL_STOPS,
         evaluate_seeds,
         train_seeds,
     )
-    from explaindrive.evaluation.spec import SpecError, parse_seeds
     from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
     try:
@@ -242,7 +243,7 @@ def _train_seeds(
             raise ConfigError("give --seed or --seeds, not both")
         seeds = parse_seeds(seeds_text)
     except (ConfigError, SpecError) as exc:
-        print_error(console, exc)
+        print_error(exc)
         raise typer.Exit(2) from None
     out = out or Path("runs") / f"{mode}-seeds"
     console.print(f"training {mode} with seeds {', '.join(map(str, seeds))} side by side -> {out}")

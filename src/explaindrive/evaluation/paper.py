@@ -12,6 +12,8 @@ from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 PAPER_SEEDS: tuple[int, ...] = (0, 1, 2, 3, 4)
 PAPER_STOP_INTERVALS_S: tuple[tuple[float, float], ...] = ((60.0, 75.0), (150.0, 165.0))
 """Stop injections used for the "with stops" speed profiles [s from the episode start]."""
+PAPER_STOP_SCHEDULE = ",".join(f"{start:g}-{end:g}" for start, end in PAPER_STOP_INTERVALS_S)
+""":data:`PAPER_STOP_INTERVALS_S` as a ``--stop-schedule`` (``"60-75,150-165"``)."""
 PAPER_MERGED_COMMANDS = "fast:0-90,stop:90-110,comfort:110-"
 """The merged single-episode run: fast, then stop, then comfort."""
 

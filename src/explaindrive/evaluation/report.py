@@ -21,7 +21,7 @@ from explaindrive.evaluation.aggregate import RunSummary, relative_difference, s
 from explaindrive.evaluation.paper import (
     PAPER_MERGED_COMMANDS,
     PAPER_RESULTS,
-    PAPER_STOP_INTERVALS_S,
+    PAPER_STOP_SCHEDULE,
     PaperRow,
 )
 from explaindrive.evaluation.runner import EpisodeRecord, Progress, run_grid, shield_counts
@@ -40,7 +40,6 @@ from explaindrive.evaluation.spec import (
 
 log = logging.getLogger(__name__)
 
-STOP_SCHEDULE_TEXT = ",".join(f"{s:g}-{e:g}" for s, e in PAPER_STOP_INTERVALS_S)
 CLOSE_REL = 0.10  # relative difference under which a figure is called close to the paper's
 SPEED_FIGURES: tuple[tuple[Collection[str], str, str], ...] = (
     (AGENTS, "speed_profiles.png", "Ego speed, mean ± 1 std over the episodes"),
@@ -118,7 +117,7 @@ def plan_report(
             continue
         runs.append(plan_run(spec, seeds, levels, max_steps=max_steps))
         runs.append(
-            plan_run(spec, seeds, levels, stop_schedule=STOP_SCHEDULE_TEXT, max_steps=max_steps)
+            plan_run(spec, seeds, levels, stop_schedule=PAPER_STOP_SCHEDULE, max_steps=max_steps)
         )
     return ReportPlan(tuple(runs), resolved, tuple(seeds), tuple(levels))
 
@@ -353,7 +352,7 @@ def _result_tables(plan: ReportPlan, summaries: Mapping[str, RunSummary]) -> lis
         "",
         tables.safety_table(grid),
         "",
-        f"Stop runs inject STOP at {STOP_SCHEDULE_TEXT} s. Stop latency: steps from the stop "
+        f"Stop runs inject STOP at {PAPER_STOP_SCHEDULE} s. Stop latency: steps from the stop "
         "command to 0 m/s; an unfinished stop ended (or the episode ended) before standstill.",
         "",
     ]

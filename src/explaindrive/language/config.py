@@ -3,29 +3,26 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import yaml
-from pydantic import ConfigDict, Field
+from pydantic import AfterValidator, Field
 
-from explaindrive.config import StrictModel
+from explaindrive.config import LaxModel, read_yaml
+from explaindrive.language.backends.registry import check_backend
 from explaindrive.language.encoders import (
     DEFAULT_RUNTIME,
     EncoderRuntime,
     check_runtime,
 )
 
-BackendName = Literal["embedded", "openai"]
+BackendName = Annotated[str, AfterValidator(check_backend)]
+"""The name of a registered language backend (:mod:`explaindrive.language.backends`)."""
 
 SUMMARY_CUTOFF_M = 50.0  # [m] objects farther than this are left out of summaries and decisions
 
 
-class _Strict(StrictModel):
-    # YAML gives paths as text and 3e-4 as a string: lax types, the other rules are shared
-    model_config = ConfigDict(strict=False)
-
-
-class SpeechConfig(_Strict):
+class SpeechConfig(LaxModel):
     """Whisper transcription settings."""
 
     model_dir: Path | None = None
@@ -42,7 +39,7 @@ class SpeechConfig(_Strict):
     """Shorter audio is rejected as empty [s]."""
 
 
-class EmbeddedConfig(_Strict):
+class EmbeddedConfig(LaxModel):
     """Offline backend: sentence embeddings + shipped classifier, rule engine, templates."""
 
     embedding_model_dir: Path | None = None
@@ -64,7 +61,7 @@ class EmbeddedConfig(_Strict):
     """[m] objects farther than this are ignored by the decider and the explainer."""
 
 
-class OpenAIConfig(_Strict):
+class OpenAIConfig(LaxModel):
     """Any OpenAI-compatible chat endpoint (OpenAI, Ollama, vLLM, llama.cpp): where it is,
     which model answers, where the key comes from, and how long a call may take."""
 
@@ -91,7 +88,7 @@ class OpenAIConfig(_Strict):
     max_tokens: int = Field(default=120, ge=8)
 
 
-class LanguageConfig(_Strict):
+class LanguageConfig(LaxModel):
     """Configuration of the whole language layer."""
 
     backend: BackendName = "embedded"
@@ -133,7 +130,7 @@ class LanguageConfig(_Strict):
         if not p.is_file():
             raise FileNotFoundError(f"language config not found: {p}")
         try:
-            raw = yaml.safe_load(p.read_text(encoding="utf-8")) or {}
+            raw = read_yaml(p.read_text(encoding="utf-8")) or {}
         except UnicodeDecodeError as exc:
             raise ValueError(f"{p}: not UTF-8 text (byte {exc.start}: {exc.reason})") from None
         except yaml.YAMLError as exc:

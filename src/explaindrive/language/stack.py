@@ -1,15 +1,11 @@
-"""One place that assembles the language layer for a backend."""
+"""One place that assembles the language layer for a backend of the registry
+(:mod:`explaindrive.language.backends`)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from explaindrive.language.backends import check_backend
-from explaindrive.language.backends.embedded import (
-    EmbeddedIntentInterpreter,
-    RuleDecider,
-    TemplateExplainer,
-)
+from explaindrive.language.backends import check_backend, get_backend
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.decision import ExplanationDecider
 from explaindrive.language.explanation import Explainer
@@ -55,7 +51,8 @@ def make_language_stack(
     ``stack.transcriber.load()`` to pay that cost up front.
 
     Args:
-        backend: ``embedded`` or ``openai``; ``None`` = ``config.backend``.
+        backend: a registered backend's name (``embedded``, ``openai``...); ``None`` =
+            ``config.backend``.
         config: the layer's configuration; ``None`` = defaults.
 
     Raises:
@@ -63,22 +60,12 @@ def make_language_stack(
     """
     cfg = config or LanguageConfig()
     name = check_backend(backend or cfg.backend)
-    interpreter: IntentInterpreter = EmbeddedIntentInterpreter(cfg.embedded)
-    decider: ExplanationDecider = RuleDecider(cfg.embedded)
-    explainer: Explainer = TemplateExplainer(cfg.embedded)
-    if name == "openai":
-        from explaindrive.language.backends.openai import (
-            ChatClient,
-            OpenAIDecider,
-            OpenAIExplainer,
-            OpenAIIntentInterpreter,
-        )
-
-        client = ChatClient(cfg.openai)
-        assert isinstance(interpreter, EmbeddedIntentInterpreter)
-        assert isinstance(decider, RuleDecider) and isinstance(explainer, TemplateExplainer)
-        interpreter = OpenAIIntentInterpreter(client, interpreter)
-        decider = OpenAIDecider(client, decider)
-        explainer = OpenAIExplainer(client, explainer)
-    remote = cfg.openai.timeout_s if name == "openai" else None
-    return LanguageStack(name, interpreter, decider, explainer, Transcriber(cfg.speech), remote)
+    modules = get_backend(name).build(cfg)
+    return LanguageStack(
+        name,
+        modules.interpreter,
+        modules.decider,
+        modules.explainer,
+        Transcriber(cfg.speech),
+        modules.remote_deadline_s,
+    )

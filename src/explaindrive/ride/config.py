@@ -17,7 +17,8 @@ class RideConfig(ConfigModel, ScenarioFields):
     """Settings of :class:`~explaindrive.ride.session.RideSession`.
 
     Attributes:
-        traffic_level: demand scale, in (0, 2] (1.0 = 900 veh/h on the main road).
+        traffic_level: demand scale, in (0, ``MAX_TRAFFIC_LEVEL``]
+            (1.0 = 900 veh/h on the main road).
         seed: simulation seed.
         max_steps: longest ride [steps of 1 s].
         backend: language backend (``embedded`` or ``openai``).

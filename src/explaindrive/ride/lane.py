@@ -17,15 +17,27 @@ import concurrent.futures as cf
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Any
 
 INTERPRETATION = "interpretation"
 EXPLANATION = "explanation"
-CHANNELS: dict[str, str] = {
-    "interpret": INTERPRETATION,
-    "transcribe": INTERPRETATION,
-    "decide": EXPLANATION,
-    "explain": EXPLANATION,
+
+
+class TaskKind(StrEnum):
+    """The kinds of language work."""
+
+    INTERPRET = "interpret"
+    TRANSCRIBE = "transcribe"
+    DECIDE = "decide"
+    EXPLAIN = "explain"
+
+
+CHANNELS: dict[TaskKind, str] = {
+    TaskKind.INTERPRET: INTERPRETATION,
+    TaskKind.TRANSCRIBE: INTERPRETATION,
+    TaskKind.DECIDE: EXPLANATION,
+    TaskKind.EXPLAIN: EXPLANATION,
 }
 """The channel of each kind of task."""
 INTERPRETATION_WORKERS = 4  # lines interpreted at the same time before one has to wait
@@ -35,11 +47,12 @@ INTERPRETATION_WORKERS = 4  # lines interpreted at the same time before one has 
 class Task:
     """A piece of language work."""
 
-    kind: str  # "interpret", "transcribe", "decide", "explain"
+    kind: TaskKind
     future: cf.Future[Any]
     submitted: float  # [s] monotonic wall time
     deadline_s: float  # [s] allowed wall time
-    context: dict[str, Any] = field(default_factory=dict)
+    context: Any = field(default_factory=dict)
+    """What the submitter needs back with the result (a ride's typed job)."""
 
     @property
     def expires(self) -> float:
@@ -87,7 +100,7 @@ class LanguageLane:
         """Tasks submitted and not yet collected."""
         return len(self._pending)
 
-    def pending_kind(self, kind: str) -> bool:
+    def pending_kind(self, kind: TaskKind | str) -> bool:
         """Whether a task of ``kind`` is pending."""
         return any(t.kind == kind for t in self._pending)
 
@@ -99,11 +112,11 @@ class LanguageLane:
 
     def submit(
         self,
-        kind: str,
+        kind: TaskKind | str,
         fn: Callable[..., Any],
         *args: Any,
         deadline_s: float,
-        context: dict[str, Any] | None = None,
+        context: Any = None,
     ) -> Task:
         """Queue ``fn(*args)`` in the channel of ``kind``; it must finish within
         ``deadline_s`` wall seconds.
@@ -112,10 +125,12 @@ class LanguageLane:
             ValueError: for a kind of task that no channel runs.
         """
         if kind not in CHANNELS:
-            raise ValueError(f"unknown language task {kind!r}; expected one of {sorted(CHANNELS)}")
+            known = sorted(k.value for k in CHANNELS)
+            raise ValueError(f"unknown language task {kind!r}; expected one of {known}")
+        task_kind = TaskKind(kind)
         submitted = time.monotonic()  # before the worker can start
-        future = self._pools[CHANNELS[kind]].submit(_run, fn, args)
-        task = Task(kind, future, submitted, deadline_s, context or {})
+        future = self._pools[CHANNELS[task_kind]].submit(_run, fn, args)
+        task = Task(task_kind, future, submitted, deadline_s, {} if context is None else context)
         self._pending.append(task)
         return task
 

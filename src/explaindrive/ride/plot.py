@@ -10,7 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from explaindrive.ride.session import StepRecord
+from explaindrive.ride.records import StepRecord
 
 COMMAND_COLOURS = {"fast": "#d62728", "comfort": "#2ca02c", "stop": "#7f7f7f"}
 

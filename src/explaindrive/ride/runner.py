@@ -31,9 +31,11 @@ from typing import IO, Any
 from explaindrive.jsonsafe import finite
 from explaindrive.language.intent import parse_confirmation_answer
 from explaindrive.redact import redact, redact_json
+from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
 from explaindrive.ride.plot import plot_ride
-from explaindrive.ride.script import AUDIO_PREFIX, ScriptLine
-from explaindrive.ride.session import RideSession, StepRecord
+from explaindrive.ride.records import StepRecord
+from explaindrive.ride.script import ScriptLine
+from explaindrive.ride.session import RideSession
 
 log = logging.getLogger(__name__)
 
@@ -178,7 +180,7 @@ def run_ride(
     lines: Sequence[ScriptLine],
     out_dir: Path,
     *,
-    typed: queue.Queue[str] | None = None,
+    typed: queue.Queue[PassengerInput | str] | None = None,
     on_step: Callable[[StepRecord], None] | None = None,
     stop: threading.Event | None = None,
 ) -> RideOutputs:
@@ -189,8 +191,9 @@ def run_ride(
         lines: timed passenger lines (already validated).
         out_dir: where ``events.jsonl``, ``summary.json`` and ``ride.png`` go (the CLI
             passes the staging folder of :func:`prepare_out_dir`; created here if missing).
-        typed: lines typed by the passenger while the ride runs (interactive mode);
-            "yes"/"no" answers a pending confirmation question.
+        typed: lines the passenger types or speaks while the ride runs (interactive
+            mode; a ``str`` is typed text); a typed "yes"/"no" answers a pending
+            confirmation question.
         on_step: called after every step (live view).
         stop: when set, the ride ends after the current step and is marked interrupted
             (with the signal of a :class:`StopRequest`, else as by Ctrl+C).
@@ -236,20 +239,17 @@ def _drive(
     session: RideSession,
     todo: deque[ScriptLine],
     events: _EventLog,
-    typed: queue.Queue[str] | None,
+    typed: queue.Queue[PassengerInput | str] | None,
     on_step: Callable[[StepRecord], None] | None,
     stop: threading.Event | None,
 ) -> None:
     """The ride loop: due lines, typed input, one step, the event log, the pace."""
-    held: list[str] = []  # typed answers waiting for their question
+    held: list[PassengerInput] = []  # typed answers waiting for their question
     while not session.done and not (stop is not None and stop.is_set()):
         tick = time.monotonic()
         while todo and todo[0].t <= session.t:
             line = todo.popleft()
-            if line.audio is not None:
-                session.say_audio(line.audio, confirm=line.confirm)
-            else:
-                session.say(line.say or "", confirm=line.confirm)
+            session.hear(line.line, confirm=line.confirm)
         _drain_typed(session, typed, held)
         rec = session.step()
         if on_step is not None:
@@ -291,10 +291,12 @@ def _finish(
 
 
 def _drain_typed(
-    session: RideSession, typed: queue.Queue[str] | None, held: list[str] | None = None
+    session: RideSession,
+    typed: queue.Queue[PassengerInput | str] | None,
+    held: list[PassengerInput] | None = None,
 ) -> None:
-    """Hand typed lines to the session; a yes/no typed while a request is still being
-    interpreted waits (in ``held``) for its question instead of becoming a new request."""
+    """Hand the passenger's lines to the session; a yes/no typed while a request is still
+    being interpreted waits (in ``held``) for its question instead of becoming a new request."""
     if typed is None:
         return
     lines = list(held or [])
@@ -302,20 +304,22 @@ def _drain_typed(
         held.clear()
     while True:
         try:
-            lines.append(typed.get_nowait())
+            item = typed.get_nowait()
         except queue.Empty:
             break
-    for raw in lines:
-        text = raw.strip()
-        if not text:
-            continue
-        if text.startswith(AUDIO_PREFIX):
-            session.say_audio(Path(text[len(AUDIO_PREFIX) :]))
-            continue
-        answer = parse_confirmation_answer(text)
-        if answer is not None and session.pending_confirmation is not None:
-            session.answer(answer)
-        elif answer is not None and session.interpreting and held is not None:
-            held.append(raw)
-        else:
-            session.say(text)
+        lines.append(TypedLine(item) if isinstance(item, str) else item)
+    for line in lines:
+        match line:
+            case SpokenLine():
+                session.hear(line)
+            case TypedLine(raw):
+                text = raw.strip()
+                if not text:
+                    continue
+                answer = parse_confirmation_answer(text)
+                if answer is not None and session.pending_confirmation is not None:
+                    session.answer(answer)
+                elif answer is not None and session.interpreting and held is not None:
+                    held.append(line)
+                else:
+                    session.say(text)

@@ -20,21 +20,19 @@ from pathlib import Path
 from typing import Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
+from explaindrive.config import LaxModel
+from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
 from explaindrive.validation import describe_errors
-
-AUDIO_PREFIX = "@audio:"  # a typed passenger line that names a recorded audio file
 
 
 class ScriptError(ValueError):
     """A ride script cannot be read or is invalid."""
 
 
-class ScriptLine(BaseModel):
+class ScriptLine(LaxModel):
     """One timed passenger line."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     t: float = Field(ge=0, description="ride time [s] at which the passenger speaks")
     say: str | None = None
@@ -53,6 +51,13 @@ class ScriptLine(BaseModel):
         if (self.say is None) == (self.audio is None):
             raise ValueError("each line needs exactly one of 'say' or 'audio'")
         return self
+
+    @property
+    def line(self) -> PassengerInput:
+        """What the passenger says: the recording, else the typed text."""
+        if self.audio is not None:
+            return SpokenLine(self.audio)
+        return TypedLine(self.say or "")
 
 
 def _read(path: Path) -> object:

@@ -13,9 +13,7 @@ so that simulated and real latencies agree.
 from __future__ import annotations
 
 import logging
-import math
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -28,95 +26,26 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import speed_change
 from explaindrive.env.metrics import EpisodeMetrics
 from explaindrive.env.urban_drive import UrbanDriveEnv
-from explaindrive.language.decision import Decision
-from explaindrive.language.explanation import Explanation
-from explaindrive.language.intent import IntentResult
-from explaindrive.language.speech import AudioError
 from explaindrive.language.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
-from explaindrive.ride.lane import EXPLANATION, LanguageLane, Outcome
+from explaindrive.ride.explaining import Explanations
+from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
+from explaindrive.ride.jobs import DecideJob, ExplainJob, InterpretJob
+from explaindrive.ride.lane import LanguageLane, Outcome, TaskKind
+from explaindrive.ride.records import PassengerRequest, RideCounts, StepRecord
+from explaindrive.ride.requests import PassengerRequests
 
 if TYPE_CHECKING:
     from explaindrive.language.stack import LanguageStack
 
 log = logging.getLogger(__name__)
 
+__all__ = ["FALLBACK_MARGIN_S", "RideCounts", "RideSession", "StepRecord", "check_deadlines"]
+
 FALLBACK_MARGIN_S = 0.2
 """[s] time a language task keeps, after a remote model's deadline, for the embedded
 module to answer instead."""
-
-
-@dataclass
-class _Request:
-    """A passenger line on its way to becoming a command."""
-
-    id: int
-    t: float
-    text: str | None
-    audio: Path | None
-    confirm: str | None  # scripted answer: "yes" / "no" / None
-    intent: Command | None = None
-    question: str | None = None
-
-
-@dataclass
-class StepRecord:
-    """Everything that happened in one step (one line of ``events.jsonl``)."""
-
-    t: float
-    state: dict[str, float]
-    command: str
-    agent: str
-    action: int
-    speed_mps: float
-    limit_mps: float
-    reward: float
-    flags: dict[str, bool]
-    passenger: list[dict[str, Any]] = field(default_factory=list)
-    decision: dict[str, Any] | None = None
-    explanation: dict[str, Any] | None = None
-    latency_s: dict[str, float] = field(default_factory=dict)
-    shield: dict[str, Any] | None = None
-    """When the safety shield replaced the network's choice: what the network chose [m/s]."""
-
-    def to_json(self) -> dict[str, Any]:
-        """JSON-ready dict."""
-        return {
-            "t": self.t,
-            "state": self.state,
-            "command": self.command,
-            "agent": self.agent,
-            "action": self.action,
-            "speed_mps": self.speed_mps,
-            "limit_mps": self.limit_mps,
-            "reward": self.reward,
-            "flags": self.flags,
-            "passenger": self.passenger,
-            "decision": self.decision,
-            "explanation": self.explanation,
-            "latency_s": self.latency_s,
-            "shield": self.shield,
-        }
-
-
-@dataclass
-class RideCounts:
-    """Counters for the ride summary."""
-
-    requests: int = 0
-    understood: int = 0
-    rephrase: int = 0
-    confirmations: int = 0
-    cancellations: int = 0
-    explain_decisions: int = 0
-    explanations: int = 0
-    suppressed_explanations: int = 0
-    fallbacks: int = 0
-    late: int = 0
-    errors: int = 0
-    superseded: int = 0
-    skipped_decisions: int = 0
 
 
 class RideSession:
@@ -142,7 +71,6 @@ class RideSession:
         check_deadlines(config, language.remote_deadline_s)
         self.config = config
         self.controller = controller
-        self.language = language
         self.env = env or UrbanDriveEnv(
             traffic_level=config.traffic_level,
             max_steps=config.max_steps,
@@ -155,14 +83,14 @@ class RideSession:
         self.counts = RideCounts()
         self.metrics = EpisodeMetrics()
         self.records: list[StepRecord] = []
-        self.pending_confirmation: _Request | None = None
-        self._requests = 0
-        self._newest_read = 0  # the latest request understood as a command
         self._inbox: list[dict[str, Any]] = []  # passenger events of the coming step
         self._obs: NDArray[np.float32] | None = None
-        self._explained_at: dict[str | None, float] = {}  # factor -> when last explained
         self.done = False
-        self.latest_explanation: dict[str, Any] | None = None
+        self.requests = PassengerRequests(
+            config, self.lane, language, controller, self.env, self.counts, self._note,
+            clock=lambda: self.t,
+        )  # fmt: skip
+        self.explanations = Explanations(config, self.lane, language, self.counts, self.records)
 
     # ------------------------------------------------------------------ lifecycle
     def start(self, command: Command = Command.FAST) -> NDArray[np.float32]:
@@ -186,7 +114,27 @@ class RideSession:
     @property
     def interpreting(self) -> bool:
         """Whether a passenger request is still being transcribed or interpreted."""
-        return self.lane.pending_kind("interpret")
+        return self.lane.pending_kind(TaskKind.INTERPRET)
+
+    @property
+    def language(self) -> LanguageStack:
+        """The language modules (replacing them reaches the requests and the explanations)."""
+        return self.requests.language
+
+    @language.setter
+    def language(self, language: LanguageStack) -> None:
+        self.requests.language = language
+        self.explanations.language = language
+
+    @property
+    def pending_confirmation(self) -> PassengerRequest | None:
+        """The interpreted request waiting for the passenger's yes or no."""
+        return self.requests.pending_confirmation
+
+    @property
+    def latest_explanation(self) -> dict[str, Any] | None:
+        """The newest explanation given, with its ride time."""
+        return self.explanations.latest
 
     @property
     def command(self) -> Command:
@@ -196,61 +144,23 @@ class RideSession:
     # ------------------------------------------------------------------ passenger input
     def say(self, text: str, confirm: str | None = None) -> int:
         """A typed passenger line; returns its request id."""
-        return self._request(text=text, audio=None, confirm=confirm)
+        return self.requests.submit(text=text, audio=None, confirm=confirm)
 
     def say_audio(self, path: str | Path, confirm: str | None = None) -> int:
         """A spoken passenger line (a WAV/FLAC/MP3 file); returns its request id."""
-        return self._request(text=None, audio=Path(path), confirm=confirm)
+        return self.requests.submit(text=None, audio=Path(path), confirm=confirm)
+
+    def hear(self, line: PassengerInput, confirm: str | None = None) -> int:
+        """A passenger line, typed or spoken; returns its request id."""
+        match line:
+            case TypedLine(text):
+                return self.say(text, confirm=confirm)
+            case SpokenLine(audio):
+                return self.say_audio(audio, confirm=confirm)
 
     def answer(self, yes: bool) -> bool:
         """Answer the pending confirmation question; ``False`` if none was pending."""
-        req = self.pending_confirmation
-        if req is None:
-            self._note({"type": EventType.ANSWER_IGNORED, "reason": "no question pending"})
-            return False
-        self._resolve(req, yes, source="passenger")
-        return True
-
-    def _request(self, text: str | None, audio: Path | None, confirm: str | None) -> int:
-        self._requests += 1
-        req = _Request(self._requests, self.t, text, audio, confirm)
-        self.counts.requests += 1
-        self._note(
-            {
-                "type": EventType.LINE,
-                "id": req.id,
-                "text": text,
-                "audio": str(audio) if audio else None,
-            }
-        )
-        self.lane.submit(
-            "interpret",
-            self._interpret,
-            req,
-            deadline_s=(
-                self.config.audio_deadline_s if audio else self.config.interpret_deadline_s
-            ),
-            context={"request": req},
-        )
-        return req.id
-
-    def _interpret(self, req: _Request) -> tuple[str, IntentResult | None, float, str | None]:
-        """Worker side: transcribe if needed, then interpret.
-
-        Returns (text, interpretation or None, transcription time, why there is no text).
-        """
-        transcript_s = 0.0
-        text = req.text or ""
-        if req.audio is not None:
-            t0 = time.perf_counter()
-            try:
-                text = self.language.transcriber.transcribe(req.audio).text
-            except AudioError as exc:
-                return "", None, time.perf_counter() - t0, str(exc)
-            transcript_s = time.perf_counter() - t0
-        if not text.strip():
-            return text, None, transcript_s, "empty request"
-        return text, self.language.interpreter.interpret(text), transcript_s, None
+        return self.requests.answer(yes)
 
     # ------------------------------------------------------------------ control step
     def step(self) -> StepRecord:
@@ -292,7 +202,7 @@ class RideSession:
         self._obs = next_obs
         self.done = terminated or truncated
         if command is not Command.STOP or change > 0:
-            self._submit_decision(record, StateRecord.from_observation(obs, change))
+            self.explanations.submit_decision(record, StateRecord.from_observation(obs, change))
         if self.done:
             self._handle(self.lane.collect(wait=True))
             record.passenger.extend(self._inbox)
@@ -306,185 +216,37 @@ class RideSession:
             return None
         return {"replaced": True, "network_action": speed_change(ctrl.last_network_action)}
 
-    def _submit_decision(self, record: StepRecord, state_record: StateRecord) -> None:
-        """Ask LLM-2 about this step, unless the explanation channel is still busy.
-
-        A slow model must not build a queue of stale decisions: while the previous
-        decision or explanation is still running, this step goes without one.
-        """
-        if self.lane.busy(EXPLANATION):
-            self.counts.skipped_decisions += 1
-            record.decision = {"explain": False, "skipped": "the explanation channel is busy"}
-            return
-        self.lane.submit(
-            "decide",
-            self.language.decider.decide,
-            state_record,
-            deadline_s=self.config.explain_deadline_s,
-            context={"record": state_record, "step": len(self.records) - 1},
-        )
-
     # ------------------------------------------------------------------ language results
     def _handle(self, outcomes: list[Outcome]) -> None:
+        """Hand each finished task to the owner of its job; log the late and the failed."""
         for out in outcomes:
-            kind = out.task.kind
             if out.late or out.error:
-                what = EventType.LATE if out.late else EventType.ERROR
-                self.counts.late += out.late
-                self.counts.errors += out.error is not None
-                self._note(
-                    {
-                        "type": what,
-                        "module": kind,
-                        "latency_s": round(out.latency_s, 4),
-                        "error": out.error,
-                        "kept_command": self.controller.command.label,
-                    }
-                )
-                log.warning("%s %s: %s", kind, what, out.error or f"{out.latency_s:.2f} s")
+                self._note_missed(out)
                 continue
-            if kind == "interpret":
-                self._on_interpretation(out)
-            elif kind == "decide":
-                self._on_decision(out)
-            elif kind == "explain":
-                self._on_explanation(out)
+            match out.task.context:
+                case InterpretJob() as job:
+                    self.requests.on_interpretation(job, out)
+                case DecideJob() as job:
+                    self.explanations.on_decision(job, out)
+                case ExplainJob() as job:
+                    self.explanations.on_explanation(job, out)
 
-    def _on_interpretation(self, out: Outcome) -> None:
-        req: _Request = out.task.context["request"]
-        text, result, transcribe_s, problem = out.result
-        if req.audio is not None:
-            self._note(
-                {
-                    "type": EventType.TRANSCRIPT,
-                    "id": req.id,
-                    "text": text,
-                    "latency_s": round(transcribe_s, 4),
-                }
-            )
-        if result is None:
-            self.counts.rephrase += 1
-            self._note(
-                {
-                    "type": EventType.REPHRASE,
-                    "id": req.id,
-                    "reason": problem,
-                    "message": "Sorry, I did not catch that. Could you say it again?",
-                }
-            )
-            return
-        self.counts.fallbacks += int(result.fallback)
+    def _note_missed(self, out: Outcome) -> None:
+        """Log a task that came back late or failed; the car keeps its command."""
+        kind = out.task.kind
+        what = EventType.LATE if out.late else EventType.ERROR
+        self.counts.late += out.late
+        self.counts.errors += out.error is not None
         self._note(
             {
-                "type": EventType.INTERPRETATION,
-                "id": req.id,
-                **result.to_json(),
+                "type": what,
+                "module": kind,
                 "latency_s": round(out.latency_s, 4),
-                "error": result.error,
-                "raw_reply": result.raw_reply,  # for the log; the page drops it
+                "error": out.error,
+                "kept_command": self.controller.command.label,
             }
         )
-        if result.intent is None:
-            self.counts.rephrase += 1
-            return
-        if req.id < self._newest_read:
-            # a later request was understood first: the passenger's last instruction counts
-            self.counts.superseded += 1
-            self._note({"type": EventType.SUPERSEDED, "id": req.id, "by": self._newest_read})
-            return
-        self.counts.understood += 1
-        self._newest_read = req.id
-        req.intent, req.question = result.intent, result.confirmation
-        if result.intent is Command.STOP and self.config.stop_without_confirm:
-            self._resolve(req, True, source="stop-without-confirm")
-        elif req.confirm is not None:
-            self._resolve(req, req.confirm == "yes", source="script")
-        elif self.config.auto_confirm:
-            self._resolve(req, True, source="auto")
-        else:
-            if self.pending_confirmation is not None:
-                self._note({"type": EventType.SUPERSEDED, "id": self.pending_confirmation.id})
-            self.pending_confirmation = req
-
-    def _resolve(self, req: _Request, yes: bool, source: str) -> None:
-        if self.pending_confirmation is req:
-            self.pending_confirmation = None
-        if not yes or req.intent is None:
-            self.counts.cancellations += 1
-            self._note(
-                {
-                    "type": EventType.CANCELLED,
-                    "id": req.id,
-                    "answer": "no",
-                    "source": source,
-                    "kept_command": self.controller.command.label,
-                }
-            )
-            return
-        self.counts.confirmations += 1
-        before = self.controller.command
-        self.controller.set_command(req.intent)
-        self.env.set_command(req.intent)
-        self._note(
-            {
-                "type": EventType.CONFIRMED,
-                "id": req.id,
-                "source": source,
-                "from": before.label,
-                "to": req.intent.label,
-            }
-        )
-
-    def _on_decision(self, out: Outcome) -> None:
-        decision: Decision = out.result
-        step = out.task.context["step"]
-        rec = self.records[step]
-        factor = decision.factor.value if decision.factor is not None else None
-        rec.decision = {
-            "explain": decision.explain,
-            "factor": factor,
-            "backend": decision.backend,
-            "fallback": decision.fallback,
-            "latency_s": round(out.latency_s, 4),
-        }
-        if decision.raw_reply is not None:  # the ride log keeps what the model said
-            rec.decision.update(vetoed=decision.vetoed, raw_reply=decision.raw_reply)
-        rec.latency_s["decide"] = out.latency_s
-        self.counts.fallbacks += int(decision.fallback)
-        if not decision.explain:
-            return
-        self.counts.explain_decisions += 1
-        last_t = self._explained_at.get(factor, -math.inf)
-        if rec.t - last_t < self.config.explanation_cooldown_s:  # rate-limited per factor
-            self.counts.suppressed_explanations += 1
-            rec.decision["suppressed"] = True
-            return
-        self._explained_at[factor] = rec.t
-        self.lane.submit(
-            "explain",
-            self.language.explainer.explain,
-            out.task.context["record"],
-            decision.factor,
-            deadline_s=self.config.explain_deadline_s,
-            context={"step": step},
-        )
-
-    def _on_explanation(self, out: Outcome) -> None:
-        exp: Explanation = out.result
-        rec = self.records[out.task.context["step"]]
-        rec.explanation = {
-            "text": exp.text,
-            "factor": exp.factor.value if exp.factor is not None else None,
-            "backend": exp.backend,
-            "fallback": exp.fallback,
-            "latency_s": round(out.latency_s, 4),
-        }
-        if exp.raw_reply is not None:
-            rec.explanation["raw_reply"] = exp.raw_reply
-        rec.latency_s["explain"] = out.latency_s
-        self.counts.explanations += 1
-        self.counts.fallbacks += int(exp.fallback)
-        self.latest_explanation = {"t": rec.t, **rec.explanation}
+        log.warning("%s %s: %s", kind, what, out.error or f"{out.latency_s:.2f} s")
 
     def _note(self, event: dict[str, Any]) -> None:
         event.setdefault("t", self.t)

@@ -7,7 +7,8 @@ from rich.table import Table
 
 from explaindrive.env.state import SENSOR_RANGE_M, LightState
 from explaindrive.ride.events import EventType
-from explaindrive.ride.session import RideSession, StepRecord
+from explaindrive.ride.records import StepRecord
+from explaindrive.ride.session import RideSession
 
 
 def _dist(value: float) -> str:

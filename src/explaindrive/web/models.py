@@ -4,35 +4,35 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import Field, field_validator
 
-from explaindrive.config import Seed, TrafficLevel
+from explaindrive.config import LaxModel, Seed, TrafficLevel
+from explaindrive.ride.config import RideConfig
 
 MAX_TEXT_CHARS = 300  # a spoken request is a sentence or two
 MAX_RIDE_STEPS = 1800  # [s] half an hour of driving
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class StartRequest(_Strict):
+class StartRequest(LaxModel):
     """Start a new ride.
 
     Attributes:
-        traffic_level: demand scale, in (0, 2] (1.0 = 900 veh/h on the main road).
+        traffic_level: demand scale, in (0, ``MAX_TRAFFIC_LEVEL``]
+            (1.0 = 900 veh/h on the main road).
         seed: simulation seed; the same seed and level give the same traffic.
         command: the command the car starts with.
         max_steps: longest ride [s].
     """
 
-    traffic_level: TrafficLevel = 1.0
-    seed: Seed = 0
+    traffic_level: TrafficLevel = RideConfig.model_fields["traffic_level"].default
+    seed: Seed = RideConfig.model_fields["seed"].default
     command: Literal["fast", "comfort", "stop"] = "comfort"
-    max_steps: int = Field(default=600, gt=0, le=MAX_RIDE_STEPS)
+    max_steps: int = Field(
+        default=RideConfig.model_fields["max_steps"].default, gt=0, le=MAX_RIDE_STEPS
+    )
 
 
-class SayRequest(_Strict):
+class SayRequest(LaxModel):
     """A typed passenger line.
 
     Attributes:
@@ -50,7 +50,7 @@ class SayRequest(_Strict):
         return value
 
 
-class AnswerRequest(_Strict):
+class AnswerRequest(LaxModel):
     """The passenger's answer to the confirmation question.
 
     Attributes:

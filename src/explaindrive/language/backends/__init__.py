@@ -1,16 +1,33 @@
-"""Backend registry: ``embedded`` (offline, default) and ``openai`` (any compatible endpoint)."""
+"""Language backends behind one registry (:mod:`~explaindrive.language.backends.registry`).
+
+``embedded`` (offline, default) and ``openai`` (any compatible endpoint) ship with the
+package (:mod:`~explaindrive.language.backends.builtin`); another backend joins with
+:func:`register_backend`.
+"""
 
 from __future__ import annotations
 
-BACKENDS: tuple[str, ...] = ("embedded", "openai")
+from explaindrive.language.backends import builtin as _builtin  # registers the shipped ones
+from explaindrive.language.backends.registry import (
+    Backend,
+    LanguageModules,
+    UnknownBackendError,
+    backend_names,
+    check_backend,
+    get_backend,
+    register_backend,
+    unregister_backend,
+)
 
+del _builtin
 
-def check_backend(name: str) -> str:
-    """Return ``name`` if it is a known backend.
-
-    Raises:
-        ValueError: naming the known backends otherwise.
-    """
-    if name not in BACKENDS:
-        raise ValueError(f"unknown language backend {name!r}; choose one of: {', '.join(BACKENDS)}")
-    return name
+__all__ = [
+    "Backend",
+    "LanguageModules",
+    "UnknownBackendError",
+    "backend_names",
+    "check_backend",
+    "get_backend",
+    "register_backend",
+    "unregister_backend",
+]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from explaindrive.agent.sweep import evaluate_seeds, seed_run_dir
 from explaindrive.cli.train import seed_run_args
+from explaindrive.evaluation.sweep import evaluate_seeds, seed_run_dir
 from tests.helpers import constant_policy
 
 

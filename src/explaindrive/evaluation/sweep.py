@@ -16,11 +16,13 @@ from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
 
+from explaindrive.evaluation.paper import PAPER_STOP_SCHEDULE
 from explaindrive.evaluation.seeds import SeedResult, evaluate_runs, seed_table
 
 DEFAULT_EVAL_SEEDS = "1000-1009"
 """Validation seeds: apart from the README's evaluation seeds (0-49) and the training pool."""
-DEFAULT_EVAL_STOPS = "60-75,150-165"
+DEFAULT_EVAL_STOPS = PAPER_STOP_SCHEDULE
+"""The stop injections of the seed table: the paper's."""
 
 
 def seed_run_dir(out: Path, seed: int) -> Path:

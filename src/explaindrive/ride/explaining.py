@@ -1,0 +1,117 @@
+"""Explanations during a ride: LLM-2 decides whether a step needs one, LLM-3 gives it.
+
+Both run in the lane's explanation channel, one task at a time. A step whose decision
+would wait behind a busy channel goes without one (a slow model must not build a queue of
+stale decisions), and an explanation for the same factor is repeated only after the
+ride's cool-down.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+from explaindrive.language.decision import Decision
+from explaindrive.language.explanation import Explanation
+from explaindrive.language.summary import StateRecord
+from explaindrive.ride.config import RideConfig
+from explaindrive.ride.jobs import DecideJob, ExplainJob
+from explaindrive.ride.lane import EXPLANATION, LanguageLane, Outcome, TaskKind
+from explaindrive.ride.records import RideCounts, StepRecord
+
+if TYPE_CHECKING:
+    from explaindrive.language.stack import LanguageStack
+
+
+class Explanations:
+    """Asks LLM-2 about steps and LLM-3 for the explanations it decides on.
+
+    Args:
+        config: ride settings (deadline, cool-down).
+        lane: the language lane the decisions and explanations run in.
+        language: the language modules (decider, explainer).
+        counts: the ride's counters.
+        records: the ride's step records, which decisions and explanations are written into.
+    """
+
+    def __init__(
+        self,
+        config: RideConfig,
+        lane: LanguageLane,
+        language: LanguageStack,
+        counts: RideCounts,
+        records: list[StepRecord],
+    ) -> None:
+        self.config = config
+        self.lane = lane
+        self.language = language
+        self.counts = counts
+        self.records = records
+        self.latest: dict[str, Any] | None = None
+        self._explained_at: dict[str | None, float] = {}  # factor -> when last explained
+
+    def submit_decision(self, record: StepRecord, state_record: StateRecord) -> None:
+        """Ask LLM-2 about the newest step, unless the explanation channel is still busy."""
+        if self.lane.busy(EXPLANATION):
+            self.counts.skipped_decisions += 1
+            record.decision = {"explain": False, "skipped": "the explanation channel is busy"}
+            return
+        self.lane.submit(
+            TaskKind.DECIDE,
+            self.language.decider.decide,
+            state_record,
+            deadline_s=self.config.explain_deadline_s,
+            context=DecideJob(state_record, len(self.records) - 1),
+        )
+
+    def on_decision(self, job: DecideJob, out: Outcome) -> None:
+        """Record LLM-2's decision; ask LLM-3 when it says explain, outside the cool-down."""
+        decision: Decision = out.result
+        rec = self.records[job.step]
+        factor = decision.factor.value if decision.factor is not None else None
+        rec.decision = {
+            "explain": decision.explain,
+            "factor": factor,
+            "backend": decision.backend,
+            "fallback": decision.fallback,
+            "latency_s": round(out.latency_s, 4),
+        }
+        if decision.raw_reply is not None:  # the ride log keeps what the model said
+            rec.decision.update(vetoed=decision.vetoed, raw_reply=decision.raw_reply)
+        rec.latency_s["decide"] = out.latency_s
+        self.counts.fallbacks += int(decision.fallback)
+        if not decision.explain:
+            return
+        self.counts.explain_decisions += 1
+        last_t = self._explained_at.get(factor, -math.inf)
+        if rec.t - last_t < self.config.explanation_cooldown_s:  # rate-limited per factor
+            self.counts.suppressed_explanations += 1
+            rec.decision["suppressed"] = True
+            return
+        self._explained_at[factor] = rec.t
+        self.lane.submit(
+            TaskKind.EXPLAIN,
+            self.language.explainer.explain,
+            job.record,
+            decision.factor,
+            deadline_s=self.config.explain_deadline_s,
+            context=ExplainJob(job.step),
+        )
+
+    def on_explanation(self, job: ExplainJob, out: Outcome) -> None:
+        """Write LLM-3's explanation into its step's record."""
+        exp: Explanation = out.result
+        rec = self.records[job.step]
+        rec.explanation = {
+            "text": exp.text,
+            "factor": exp.factor.value if exp.factor is not None else None,
+            "backend": exp.backend,
+            "fallback": exp.fallback,
+            "latency_s": round(out.latency_s, 4),
+        }
+        if exp.raw_reply is not None:
+            rec.explanation["raw_reply"] = exp.raw_reply
+        rec.latency_s["explain"] = out.latency_s
+        self.counts.explanations += 1
+        self.counts.fallbacks += int(exp.fallback)
+        self.latest = {"t": rec.t, **rec.explanation}

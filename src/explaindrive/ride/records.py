@@ -1,0 +1,81 @@
+"""What a ride keeps: one record per step, the ride's counters, the passenger's requests."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from explaindrive.commands import Command
+
+
+@dataclass
+class PassengerRequest:
+    """A passenger line on its way to becoming a command."""
+
+    id: int
+    t: float
+    text: str | None
+    audio: Path | None
+    confirm: str | None  # scripted answer: "yes" / "no" / None
+    intent: Command | None = None
+    question: str | None = None
+
+
+@dataclass
+class StepRecord:
+    """Everything that happened in one step (one line of ``events.jsonl``)."""
+
+    t: float
+    state: dict[str, float]
+    command: str
+    agent: str
+    action: int
+    speed_mps: float
+    limit_mps: float
+    reward: float
+    flags: dict[str, bool]
+    passenger: list[dict[str, Any]] = field(default_factory=list)
+    decision: dict[str, Any] | None = None
+    explanation: dict[str, Any] | None = None
+    latency_s: dict[str, float] = field(default_factory=dict)
+    shield: dict[str, Any] | None = None
+    """When the safety shield replaced the network's choice: what the network chose [m/s]."""
+
+    def to_json(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        return {
+            "t": self.t,
+            "state": self.state,
+            "command": self.command,
+            "agent": self.agent,
+            "action": self.action,
+            "speed_mps": self.speed_mps,
+            "limit_mps": self.limit_mps,
+            "reward": self.reward,
+            "flags": self.flags,
+            "passenger": self.passenger,
+            "decision": self.decision,
+            "explanation": self.explanation,
+            "latency_s": self.latency_s,
+            "shield": self.shield,
+        }
+
+
+@dataclass
+class RideCounts:
+    """Counters for the ride summary."""
+
+    requests: int = 0
+    understood: int = 0
+    rephrase: int = 0
+    confirmations: int = 0
+    cancellations: int = 0
+    explain_decisions: int = 0
+    explanations: int = 0
+    suppressed_explanations: int = 0
+    fallbacks: int = 0
+    late: int = 0
+    errors: int = 0
+    superseded: int = 0
+    skipped_decisions: int = 0

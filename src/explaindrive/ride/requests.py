@@ -1,0 +1,205 @@
+"""The passenger's requests: from a line to a confirmed command.
+
+A line is transcribed (when spoken) and interpreted (LLM-1) in the language lane; a
+command read from it is confirmed (by the passenger, the script or the ride's settings)
+before the car follows it. A confirmed command goes to the controller, which drives by it,
+and to the environment, which rewards and measures by it.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from explaindrive.commands import Command
+from explaindrive.language.speech import AudioError
+from explaindrive.ride.config import RideConfig
+from explaindrive.ride.events import EventType
+from explaindrive.ride.jobs import Interpretation, InterpretJob
+from explaindrive.ride.lane import LanguageLane, Outcome, TaskKind
+from explaindrive.ride.records import PassengerRequest, RideCounts
+
+if TYPE_CHECKING:
+    from explaindrive.agent.controller import MergedController
+    from explaindrive.env.urban_drive import UrbanDriveEnv
+    from explaindrive.language.stack import LanguageStack
+
+Note = Callable[[dict[str, Any]], None]
+"""Adds a passenger event to the coming step's record."""
+
+REPHRASE_MESSAGE = "Sorry, I did not catch that. Could you say it again?"
+
+
+class PassengerRequests:
+    """Takes passenger lines, has them interpreted, and applies the confirmed commands.
+
+    Args:
+        config: ride settings (deadlines, confirmation rules).
+        lane: the language lane the interpretation runs in.
+        language: the language modules (transcriber, interpreter).
+        controller: drives by the confirmed command.
+        env: rewards and measures by the confirmed command.
+        counts: the ride's counters.
+        note: adds a passenger event to the coming step's record.
+        clock: the ride time [s].
+    """
+
+    def __init__(
+        self,
+        config: RideConfig,
+        lane: LanguageLane,
+        language: LanguageStack,
+        controller: MergedController,
+        env: UrbanDriveEnv,
+        counts: RideCounts,
+        note: Note,
+        clock: Callable[[], float],
+    ) -> None:
+        self.config = config
+        self.lane = lane
+        self.language = language
+        self.controller = controller
+        self.env = env
+        self.counts = counts
+        self._note = note
+        self._clock = clock
+        self.pending_confirmation: PassengerRequest | None = None
+        self._requests = 0
+        self._newest_read = 0  # the latest request understood as a command
+
+    def submit(self, text: str | None, audio: Path | None, confirm: str | None) -> int:
+        """Queue a line for interpretation; returns its request id."""
+        self._requests += 1
+        req = PassengerRequest(self._requests, self._clock(), text, audio, confirm)
+        self.counts.requests += 1
+        self._note(
+            {
+                "type": EventType.LINE,
+                "id": req.id,
+                "text": text,
+                "audio": str(audio) if audio else None,
+            }
+        )
+        self.lane.submit(
+            TaskKind.INTERPRET,
+            self._interpret,
+            req,
+            deadline_s=(
+                self.config.audio_deadline_s if audio else self.config.interpret_deadline_s
+            ),
+            context=InterpretJob(req),
+        )
+        return req.id
+
+    def answer(self, yes: bool) -> bool:
+        """Answer the pending confirmation question; ``False`` if none was pending."""
+        req = self.pending_confirmation
+        if req is None:
+            self._note({"type": EventType.ANSWER_IGNORED, "reason": "no question pending"})
+            return False
+        self._resolve(req, yes, source="passenger")
+        return True
+
+    def _interpret(self, req: PassengerRequest) -> Interpretation:
+        """Worker side: transcribe if needed, then interpret."""
+        transcript_s = 0.0
+        text = req.text or ""
+        if req.audio is not None:
+            t0 = time.perf_counter()
+            try:
+                text = self.language.transcriber.transcribe(req.audio).text
+            except AudioError as exc:
+                return Interpretation("", None, time.perf_counter() - t0, str(exc))
+            transcript_s = time.perf_counter() - t0
+        if not text.strip():
+            return Interpretation(text, None, transcript_s, "empty request")
+        return Interpretation(text, self.language.interpreter.interpret(text), transcript_s, None)
+
+    def on_interpretation(self, job: InterpretJob, out: Outcome) -> None:
+        """Log what was heard and understood; confirm the command or ask the question."""
+        req = job.request
+        heard: Interpretation = out.result
+        result = heard.result
+        if req.audio is not None:
+            self._note(
+                {
+                    "type": EventType.TRANSCRIPT,
+                    "id": req.id,
+                    "text": heard.text,
+                    "latency_s": round(heard.transcribe_s, 4),
+                }
+            )
+        if result is None:
+            self.counts.rephrase += 1
+            self._note(
+                {
+                    "type": EventType.REPHRASE,
+                    "id": req.id,
+                    "reason": heard.problem,
+                    "message": REPHRASE_MESSAGE,
+                }
+            )
+            return
+        self.counts.fallbacks += int(result.fallback)
+        self._note(
+            {
+                "type": EventType.INTERPRETATION,
+                "id": req.id,
+                **result.to_json(),
+                "latency_s": round(out.latency_s, 4),
+                "error": result.error,
+                "raw_reply": result.raw_reply,  # for the log; the page drops it
+            }
+        )
+        if result.intent is None:
+            self.counts.rephrase += 1
+            return
+        if req.id < self._newest_read:
+            # a later request was understood first: the passenger's last instruction counts
+            self.counts.superseded += 1
+            self._note({"type": EventType.SUPERSEDED, "id": req.id, "by": self._newest_read})
+            return
+        self.counts.understood += 1
+        self._newest_read = req.id
+        req.intent, req.question = result.intent, result.confirmation
+        if result.intent is Command.STOP and self.config.stop_without_confirm:
+            self._resolve(req, True, source="stop-without-confirm")
+        elif req.confirm is not None:
+            self._resolve(req, req.confirm == "yes", source="script")
+        elif self.config.auto_confirm:
+            self._resolve(req, True, source="auto")
+        else:
+            if self.pending_confirmation is not None:
+                self._note({"type": EventType.SUPERSEDED, "id": self.pending_confirmation.id})
+            self.pending_confirmation = req
+
+    def _resolve(self, req: PassengerRequest, yes: bool, source: str) -> None:
+        if self.pending_confirmation is req:
+            self.pending_confirmation = None
+        if not yes or req.intent is None:
+            self.counts.cancellations += 1
+            self._note(
+                {
+                    "type": EventType.CANCELLED,
+                    "id": req.id,
+                    "answer": "no",
+                    "source": source,
+                    "kept_command": self.controller.command.label,
+                }
+            )
+            return
+        self.counts.confirmations += 1
+        before = self.controller.command
+        self.controller.set_command(req.intent)
+        self.env.set_command(req.intent)
+        self._note(
+            {
+                "type": EventType.CONFIRMED,
+                "id": req.id,
+                "source": source,
+                "from": before.label,
+                "to": req.intent.label,
+            }
+        )
