@@ -1,0 +1,72 @@
+"""Time ``explaindrive --help`` and every subcommand's ``--help`` in fresh processes.
+
+Each figure is the median wall time of ``--runs`` runs of ``python -m explaindrive.cli
+<command> --help``, printed against the 0.5 s target with their ratio. Run with the
+interpreter of the install to measure::
+
+    python benchmarks/bench_cli.py [--runs 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import time
+
+TARGET_S = 0.5
+COMMANDS: tuple[tuple[str, ...], ...] = (
+    (),
+    ("demo",),
+    ("train",),
+    ("evaluate",),
+    ("report",),
+    ("ride",),
+    ("interpret",),
+    ("explain",),
+    ("transcribe",),
+    ("serve",),
+    ("scenario",),
+    ("scenario", "build"),
+    ("scenario", "random"),
+    ("scenario", "plot"),
+    ("score",),
+    ("score", "intents"),
+    ("score", "decisions"),
+)
+
+
+def help_time_s(args: tuple[str, ...]) -> float:
+    """Wall time of one ``explaindrive <args> --help`` in a fresh interpreter [s].
+
+    Raises:
+        RuntimeError: if the command fails.
+    """
+    cmd = [sys.executable, "-m", "explaindrive.cli", *args, "--help"]
+    t0 = time.perf_counter()
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    elapsed_s = time.perf_counter() - t0
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed: {done.stderr.strip()}")
+    return elapsed_s
+
+
+def main() -> int:
+    """Print each command's median help time against the target; 1 if one misses it."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=5, help="runs per command (median)")
+    runs = parser.parse_args().runs
+    worst = 0.0
+    print(f"explaindrive --help, median of {runs} fresh processes (target {TARGET_S} s)")
+    for args in COMMANDS:
+        median_s = statistics.median(help_time_s(args) for _ in range(runs))
+        worst = max(worst, median_s)
+        label = " ".join(["explaindrive", *args, "--help"])
+        print(f"{label:<40} {median_s:6.3f} s  ratio {median_s / TARGET_S:4.2f}")
+    print(f"slowest {worst:.3f} s: {'within' if worst <= TARGET_S else 'over'} the target")
+    return 0 if worst <= TARGET_S else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
