@@ -21,8 +21,6 @@ from __future__ import annotations
 
 import importlib
 import sys
-from importlib.abc import MetaPathFinder
-from importlib.machinery import ModuleSpec
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
@@ -30,6 +28,7 @@ from explaindrive.commands import Command
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
+    from importlib.machinery import ModuleSpec
 
 __version__ = "0.1.0"
 
@@ -88,8 +87,9 @@ def _register_env(registration: ModuleType) -> None:
         registration.register(id=ENV_ID, entry_point=ENTRY_POINT)
 
 
-class _RegisterWithGymnasium(MetaPathFinder):
-    """Registers :data:`ENV_ID` right after ``gymnasium.envs.registration`` loads."""
+class _RegisterWithGymnasium:
+    """Registers :data:`ENV_ID` right after ``gymnasium.envs.registration`` loads (a
+    :class:`importlib.abc.MetaPathFinder`, without importing :mod:`importlib.abc`)."""
 
     target = "gymnasium.envs.registration"
 
