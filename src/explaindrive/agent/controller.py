@@ -172,7 +172,7 @@ class MergedController:
 
         Whoever changes the command (a passenger in a ride or on the page, an evaluation's
         schedule) changes it on the environment (``env.set_command`` or the ``command`` and
-        ``schedule`` reset options); the controller follows it with this call.
+        ``command_schedule`` reset options); the controller follows it with this call.
         """
         self.set_command(env.command)
 
