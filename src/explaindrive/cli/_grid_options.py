@@ -14,7 +14,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from explaindrive.cli._errors import print_error
 from explaindrive.limits import MAX_STEPS, MAX_WORKERS
-from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
+from explaindrive.sim.scenario.limits import TRAFFIC_LEVELS
 
 if TYPE_CHECKING:
     from explaindrive.evaluation.runner import Progress as EpisodeProgress

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from rich.console import Console
 
 from explaindrive.cli._errors import refuse
-from explaindrive.language.config import LanguageConfig
+
+if TYPE_CHECKING:
+    from explaindrive.language.config import LanguageConfig
 
 console = Console()
 
@@ -26,6 +28,8 @@ def read_config(path: Path | None, model: str | None = None) -> LanguageConfig:
         FileNotFoundError: if ``path`` does not exist.
         ValueError: if the file is malformed, or ``model`` is empty.
     """
+    from explaindrive.language.config import LanguageConfig
+
     config = LanguageConfig() if path is None else LanguageConfig.from_yaml(path)
     return config.with_model(model)
 

@@ -7,11 +7,6 @@ from rich.console import Console
 from rich.table import Table
 
 from explaindrive.cli._errors import print_error
-from explaindrive.commands import Command
-from explaindrive.env.config import EnvConfig
-from explaindrive.env.metrics import EpisodeMetrics
-from explaindrive.env.scripted import CautiousDriver
-from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.limits import MAX_SEED
 
 
@@ -21,6 +16,12 @@ def demo(
     command: str = typer.Option("fast", help="Passenger command: fast, comfort or stop."),
 ) -> None:
     """Drive one episode with the cautious rule-based driver and print its figures."""
+    from explaindrive.commands import Command
+    from explaindrive.env.config import EnvConfig
+    from explaindrive.env.metrics import EpisodeMetrics
+    from explaindrive.env.scripted import CautiousDriver
+    from explaindrive.env.urban_drive import UrbanDriveEnv
+
     console = Console()
     try:
         cmd = Command.parse(command)

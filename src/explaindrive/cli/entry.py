@@ -1,7 +1,8 @@
 """The ``explaindrive`` program: one line for every refusal, signals handled from the start.
 
 A usage error (an unknown option, a number outside its range, a missing argument) is one
-line, ``error: <what is wrong>``, with exit status 2. Imports of the command modules take
+line, ``error: <what is wrong>``, with exit status 2. A command that needs an extra that is
+not installed says which, on one line, with exit status 1. Imports of the command modules take
 a second or more (torch, matplotlib); a Ctrl+C or a SIGTERM in that time, or in a command
 without its own handling, ends the program with one line naming the signal and status
 128 + its number, never a traceback. Later signals, while the program is already
@@ -14,6 +15,12 @@ import sys
 from types import FrameType
 
 from explaindrive.cli._signals import HANDLED_SIGNALS, SignalInterrupt, exit_status, signal_label
+
+
+def command_name(args: list[str]) -> str:
+    """``explaindrive <command>`` for the command line ``args``, for error messages."""
+    words = [a for a in args if not a.startswith("-")][:1]
+    return " ".join(["explaindrive", *words])
 
 
 def main() -> None:
@@ -47,6 +54,14 @@ def main() -> None:
             code = exc.exit_code
         except Abort:
             print("error: aborted", file=sys.stderr)
+            code = 1
+        except ModuleNotFoundError as exc:  # a package of an extra that is not installed
+            from explaindrive.extras import missing_extra
+
+            missing = missing_extra(exc, command_name(sys.argv[1:]))
+            if missing is None:
+                raise
+            print(f"error: {missing}", file=sys.stderr)
             code = 1
     except KeyboardInterrupt:
         code = exit_status(received[0] if received else signal.SIGINT)

@@ -6,7 +6,7 @@ import contextlib
 import json
 import math
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -19,7 +19,9 @@ from explaindrive.cli._language_common import (
     fail,
     load_config,
 )
-from explaindrive.language.summary import StateRecord, environment_summary
+
+if TYPE_CHECKING:
+    from explaindrive.language.summary import StateRecord
 
 
 def explain_command(
@@ -30,6 +32,8 @@ def explain_command(
     model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Decide whether a step's action needs explaining and, if so, explain it."""
+    from explaindrive.language.summary import environment_summary
+
     try:
         record = read_case(case)
         from explaindrive.language.stack import make_language_stack
@@ -76,6 +80,8 @@ def read_case(path: Path) -> StateRecord:
     except UnicodeDecodeError as exc:
         raise ValueError(f"{path}: not UTF-8 text (byte {exc.start}: {exc.reason})") from exc
     _check_finite(text, str(path))
+    from explaindrive.language.summary import StateRecord
+
     return StateRecord.from_json(text, source=str(path))
 
 

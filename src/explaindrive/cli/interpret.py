@@ -16,7 +16,6 @@ from explaindrive.cli._language_common import (
     fail,
     load_config,
 )
-from explaindrive.language.speech import AudioError
 
 
 def interpret_command(
@@ -28,6 +27,8 @@ def interpret_command(
     model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Map a passenger request (text or --audio) to fast, comfort, stop or no command."""
+    from explaindrive.language.speech import AudioError
+
     if (text is None) == (audio is None):
         fail("give either TEXT or --audio FILE")
     try:

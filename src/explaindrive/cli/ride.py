@@ -33,27 +33,15 @@ from explaindrive.cli._errors import print_error, refuse
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption, obs_noise_sd
 from explaindrive.cli._language_common import read_config
 from explaindrive.cli._signals import HANDLED_SIGNALS, exit_status, handle_signals, signal_label
-from explaindrive.language.config import LanguageConfig
 from explaindrive.limits import MAX_SEED
 from explaindrive.redact import redact
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
-from explaindrive.ride.runner import (
-    OutputDirError,
-    StopRequest,
-    commit_ride,
-    discard_ride,
-    prepare_out_dir,
-)
-from explaindrive.ride.script import (
-    ScriptError,
-    ScriptLine,
-    default_script_path,
-    load_script,
-)
 
 if TYPE_CHECKING:
+    from explaindrive.language.config import LanguageConfig
     from explaindrive.ride.runner import RideOutputs
+    from explaindrive.ride.script import ScriptLine
     from explaindrive.ride.session import RideSession
 
 console = Console()
@@ -143,6 +131,9 @@ def ride(
     model: ModelOption = None,
 ) -> None:
     """Ride in the simulated car: ask for fast, comfort or stop; watch it drive and explain."""
+    from explaindrive.ride.runner import OutputDirError, prepare_out_dir
+    from explaindrive.ride.script import ScriptError, default_script_path
+
     if voice and not interactive:
         _refuse("--voice needs --interactive")
     try:
@@ -183,6 +174,8 @@ def _script_lines(script: Path | None, interactive: bool, max_steps: int) -> lis
     Raises:
         ScriptError: if the script cannot be read or holds a bad line.
     """
+    from explaindrive.ride.script import default_script_path, load_script
+
     if interactive and script is None:
         return []
     return load_script(script or default_script_path(), max_time_s=float(max_steps))
@@ -273,7 +266,7 @@ def _run(
     step. From here on a signal stops the ride after the current step (and later ones
     change nothing); an error ends in one line and status 1; a stop before the first step
     leaves ``out`` as it was."""
-    from explaindrive.ride.runner import run_ride
+    from explaindrive.ride.runner import StopRequest, commit_ride, discard_ride, run_ride
     from explaindrive.ride.view import render
 
     stop = StopRequest()

@@ -9,7 +9,6 @@ from rich.console import Console
 
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._paths import refuse_bad_outputs
-from explaindrive.sim.scenario.files import package_data_dir
 
 scenario_app = typer.Typer(help="Build or draw urban SUMO scenarios.", no_args_is_help=True)
 
@@ -30,6 +29,8 @@ def build(
 
     refuse_bad_outputs(folders=((out, "--out"),))
     if not settings:
+        from explaindrive.sim.scenario.files import package_data_dir
+
         net = build_network(out or package_data_dir())
         Console().print(f"network written to {net}")
         return
@@ -70,6 +71,7 @@ def plot(
     net: Path = typer.Option(None, help="Network file (default: the shipped scenario)."),
 ) -> None:
     """Draw the network to a PNG."""
+    from explaindrive.sim.scenario.files import package_data_dir
     from explaindrive.sim.scenario.plot import plot_network
 
     refuse_bad_outputs(files=((out, "--out"),))

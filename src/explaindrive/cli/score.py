@@ -18,13 +18,6 @@ from explaindrive.cli._language_common import (
     load_config,
 )
 from explaindrive.cli._paths import refuse_bad_outputs
-from explaindrive.language.datasets import (
-    DECISIONS_JSONL,
-    TEST_CSV,
-    data_path,
-    load_commands,
-    load_decisions,
-)
 
 score_app = typer.Typer(
     name="score",
@@ -32,8 +25,9 @@ score_app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
 )
-DEFAULT_COMMANDS = data_path(TEST_CSV)
-DEFAULT_DECISIONS = data_path(DECISIONS_JSONL)
+# the shipped files (explaindrive.language.datasets), named without importing the readers
+SHIPPED_COMMANDS = "the shipped commands_test.csv"
+SHIPPED_DECISIONS = "the shipped decisions.jsonl"
 
 
 def _write(out: Path | None, data: dict[str, Any]) -> None:
@@ -45,15 +39,21 @@ def _write(out: Path | None, data: dict[str, Any]) -> None:
 
 def intents_command(
     data: Annotated[
-        Path, typer.Option("--data", help="CSV text,label[,kind][,split].")
-    ] = DEFAULT_COMMANDS,
+        Path | None,
+        typer.Option(
+            "--data", help="CSV text,label[,kind][,split].", show_default=SHIPPED_COMMANDS
+        ),
+    ] = None,
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
     model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
+    from explaindrive.language.datasets import TEST_CSV, data_path, load_commands
+
     refuse_bad_outputs(files=((out, "--json"),))
+    data = data or data_path(TEST_CSV)
     try:
         rows = load_commands(data)
         from explaindrive.language.stack import make_language_stack
@@ -91,8 +91,9 @@ def intents_command(
 
 def decisions_command(
     data: Annotated[
-        Path, typer.Option("--data", help="JSONL of labelled records.")
-    ] = DEFAULT_DECISIONS,
+        Path | None,
+        typer.Option("--data", help="JSONL of labelled records.", show_default=SHIPPED_DECISIONS),
+    ] = None,
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
@@ -100,7 +101,10 @@ def decisions_command(
 ) -> None:
     """Trigger accuracy/precision/recall/F1, factor accuracy and checked explanations of
     LLM-2/LLM-3."""
+    from explaindrive.language.datasets import DECISIONS_JSONL, data_path, load_decisions
+
     refuse_bad_outputs(files=((out, "--json"),))
+    data = data or data_path(DECISIONS_JSONL)
     try:
         rows = load_decisions(data)
         from explaindrive.language.stack import make_language_stack

@@ -11,8 +11,6 @@ from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import ComfortPolicyOption, FastPolicyOption
 from explaindrive.cli._language_common import CONFIG_HELP, MODEL_HELP, read_config
-from explaindrive.language.backends import check_backend
-from explaindrive.language.encoders import check_installed
 
 console = Console()
 
@@ -49,6 +47,8 @@ def serve(
     """Serve the passenger page: watch the ride, talk to the car, read its explanations."""
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.controller import MergedController
+    from explaindrive.language.backends import check_backend
+    from explaindrive.language.encoders import check_installed
     from explaindrive.web import create_app
     from explaindrive.web.app import RealStack
     from explaindrive.web.guard import LOOPBACK_HOSTS, served_hosts

@@ -10,15 +10,6 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from explaindrive.agent.config import (
-    DEFAULT_PRESET,
-    TRAIN_MODES,
-    ConfigError,
-    TrainConfig,
-    build_config,
-    load_config_file,
-    parse_override,
-)
 from explaindrive.cli import _scenario_options as where
 from explaindrive.cli._errors import print_error
 from explaindrive.cli._grid_options import check_ray_target
@@ -26,12 +17,15 @@ from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.limits import MAX_EPISODES, MAX_WORKERS
 
 if TYPE_CHECKING:
+    from explaindrive.agent.config import TrainConfig
     from explaindrive.agent.trainer import TrainResult
 
 console = Console()
 
 
 def _saved_config(out: Path) -> dict[str, Any] | None:
+    from explaindrive.agent.config import ConfigError
+
     path = out / "config.json"
     if not path.is_file():
         return None
@@ -58,6 +52,16 @@ def resolve_config(
     Raises:
         ConfigError: on an unknown mode, preset, key or an invalid value.
     """
+    from explaindrive.agent.config import (
+        DEFAULT_PRESET,
+        TRAIN_MODES,
+        ConfigError,
+        TrainConfig,
+        build_config,
+        load_config_file,
+        parse_override,
+    )
+
     if mode not in TRAIN_MODES:
         raise ConfigError(
             f"unknown mode {mode!r}: choose one of {', '.join(TRAIN_MODES)} "
@@ -150,6 +154,7 @@ def train_command(
 ) -> None:
     """Train a D3QN driving agent with the paper's command schedule."""
     from explaindrive.agent.checkpoint import CheckpointError
+    from explaindrive.agent.config import ConfigError
     from explaindrive.agent.trainer import Trainer
 
     try:
@@ -229,6 +234,7 @@ def _train_seeds(
 ) -> None:
     """``--seeds``: one run per seed, then the combined table
     (:mod:`explaindrive.evaluation.sweep`)."""
+    from explaindrive.agent.config import ConfigError
     from explaindrive.evaluation.spec import SpecError, parse_seeds
     from explaindrive.evaluation.sweep import (
         DEFAULT_EVAL_SEEDS,

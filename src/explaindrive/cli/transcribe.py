@@ -8,7 +8,6 @@ from typing import Annotated
 import typer
 
 from explaindrive.cli._language_common import CONFIG_HELP, console, emit_json, fail, load_config
-from explaindrive.language.speech import AudioError, Transcriber
 
 
 def transcribe_command(
@@ -17,6 +16,8 @@ def transcribe_command(
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
 ) -> None:
     """Transcribe a spoken request with Whisper (tiny.en, offline)."""
+    from explaindrive.language.speech import AudioError, Transcriber
+
     cfg = load_config(config)
     try:
         t = Transcriber(cfg.speech).transcribe(file)

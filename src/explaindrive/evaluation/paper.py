@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
+from explaindrive.sim.scenario.limits import TRAFFIC_LEVELS
 
 PAPER_SEEDS: tuple[int, ...] = (0, 1, 2, 3, 4)
 PAPER_STOP_INTERVALS_S: tuple[tuple[float, float], ...] = ((60.0, 75.0), (150.0, 165.0))

@@ -67,7 +67,7 @@ def _load_driver(policy: PolicySpec) -> Any:
 def _decide(policy: PolicySpec, driver: Any, env: Any, obs: np.ndarray) -> int:
     if policy.kind == "baseline":
         return IDLE_ACTION  # SUMO drives the ego; the action is ignored
-    driver.set_command(env.command)
+    driver.follow(env)  # the env holds the command (and its schedule)
     return int(driver.act(obs))
 
 

@@ -25,7 +25,7 @@ from typing import Any
 
 from explaindrive.commands import COMMAND_LABELS, Command
 from explaindrive.limits import MAX_SEEDS, MAX_STEPS
-from explaindrive.sim.scenario.layout import validate_seed, validate_traffic_level
+from explaindrive.sim.scenario.limits import validate_seed, validate_traffic_level
 
 BASELINES: tuple[str, ...] = ("krauss", "idm")
 AGENTS: tuple[str, ...] = ("fast", "comfort")

@@ -192,8 +192,8 @@ class PassengerRequests:
             return
         self.counts.confirmations += 1
         before = self.controller.command
-        self.controller.set_command(req.intent)
         self.env.set_command(req.intent)
+        self.controller.follow(self.env)
         self._note(
             {
                 "type": EventType.CONFIRMED,

@@ -95,8 +95,8 @@ class RideSession:
     # ------------------------------------------------------------------ lifecycle
     def start(self, command: Command = Command.FAST) -> NDArray[np.float32]:
         """Reset the environment; the ride starts under ``command``."""
-        self.controller.set_command(command)
         obs, _ = self.env.reset(seed=self.config.seed, options={"command": command.label})
+        self.controller.follow(self.env)
         self._obs = obs
         self.done = False
         return obs
@@ -138,7 +138,8 @@ class RideSession:
 
     @property
     def command(self) -> Command:
-        """The confirmed command the car follows."""
+        """The confirmed command the car follows: the environment holds it, the controller
+        follows it (and keeps it readable after the ride)."""
         return self.controller.command
 
     # ------------------------------------------------------------------ passenger input
@@ -172,6 +173,7 @@ class RideSession:
         if self._obs is None or self.done:
             raise RuntimeError("the ride is not running; call start()")
         self._handle(self.lane.collect(wait=not self.config.realtime))
+        self.controller.follow(self.env)
         obs = self.controller.observation(self._obs)
         t0 = time.perf_counter()
         action = self.controller.act(obs)
