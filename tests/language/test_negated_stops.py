@@ -69,7 +69,6 @@ def test_off_topic_remarks_with_driving_words_get_no_command(
         "This is me, let me out.",
         "don't go any further, this is it",
         "Don't stop here, stop at the bakery.",
-        "If you don't stop now I'll be sick.",
     ],
 )
 def test_requests_to_stop_stay_stops(interpreter: EmbeddedIntentInterpreter, line: str) -> None:
