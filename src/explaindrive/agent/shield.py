@@ -1,26 +1,12 @@
-"""A kinematic safety shield: which actions keep a stopping option, and the best safe one.
+"""A kinematic safety shield: the best-valued action that keeps a stopping option.
 
-An action is safe when, after it, the ego could still stop braking at -3 m/s per step:
-
-- behind its real leader, even if that leader brakes at 9 m/s^2 (SUMO's emergency
-  deceleration), with a 2 m margin;
-- before a red or yellow light and before an occupied crossing (the virtual leaders);
-- without exceeding the posted limit (above it, only the hardest braking is safe).
-
-Standing still after the step is safe with respect to every stop line and leader.
-
-A yellow light that even the hardest braking cannot stop for is the dilemma zone: the
-ego goes on without slowing down, since braking would only leave it on the junction at
-red. At run time (:func:`shield`) braking there is unsafe; the training mask
-(:func:`safe_action_mask` with ``dilemma_braking=True``) leaves it allowed, so that
-learning is not taught to forbid it. Under STOP the shield also keeps the stop within its
-latency bound (ceil(v/3) + 2 steps from the command); the training mask asks instead that
-every step under STOP brings the standstill one hardest-braking step closer, which keeps
-that bound without knowing when the command came.
-
-The rules are written once, vectorised over a batch of raw observations, in
-:mod:`explaindrive.env.safety` (the environment reports the same mask); the scalar helpers
-here index it.
+Which actions are safe is the rule of :mod:`explaindrive.env.safety`, written once and
+vectorised over a batch of raw observations (the environment reports the same mask); it is
+re-exported here, and the scalar helpers index it. At run time (:func:`shield`) braking in
+a yellow light's dilemma zone is unsafe; the training mask leaves it allowed. Under STOP the
+shield also keeps the stop within its latency bound (ceil(v/3) + 2 steps from the command);
+the training mask asks instead that every step under STOP brings the standstill one
+hardest-braking step closer, which keeps that bound without knowing when the command came.
 """
 
 from __future__ import annotations

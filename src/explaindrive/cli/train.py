@@ -68,8 +68,10 @@ def resolve_config(
             "(stop is not a separate agent; both agents learn to obey it)"
         )
     changes: dict[str, Any] = dict(parse_override(item) for item in overrides)
+    from explaindrive.sim.scenario.choice import RANDOM
+
     place = {k: v for k, v in options.items() if v is not None}
-    if place.keys() & {"scenario", "net_file", "route"} and place.get("scenario") != "random":
+    if place.keys() & {"scenario", "net_file", "route"} and place.get("scenario") != RANDOM:
         # a scenario or network given on the command line replaces the preset's family
         changes.update(scenario=None, scenario_paper_share=0.0)
     changes.update(place)

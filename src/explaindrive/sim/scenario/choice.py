@@ -14,6 +14,9 @@ from pydantic import (
 
 from explaindrive.config import FROM_LIST, StrictModel, TextPath
 
+RANDOM = "random"
+"""The scenario setting that draws generated scenarios during training."""
+
 
 class ScenarioFields(StrictModel):
     """Where the ego drives: the paper's road (nothing set), a scenario directory, generated
@@ -44,7 +47,7 @@ class ScenarioFields(StrictModel):
     def _check_scenario(self) -> Self:
         if self.scenario is not None and (self.net_file or self.route or self.demand_file):
             raise ValueError("give a scenario or a network (net_file/route/demand_file), not both")
-        if self.scenario_paper_share > 0.0 and self.scenario != "random":
+        if self.scenario_paper_share > 0.0 and self.scenario != RANDOM:
             raise ValueError("scenario_paper_share needs scenario='random'")
         if self.route is not None and self.net_file is None:
             raise ValueError("route needs net_file, the network it runs on")

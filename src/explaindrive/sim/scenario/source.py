@@ -5,10 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from explaindrive.sim.scenario.choice import RANDOM
 from explaindrive.sim.scenario.files import ScenarioFiles, default_scenario
-
-RANDOM = "random"
-"""The scenario setting that draws generated scenarios during training."""
 
 
 class ScenarioSource:
