@@ -126,7 +126,7 @@ def generated_trips(net_file: Path, cache_dir: Path, traffic_level: float = 1.0)
     tmp = Path(tempfile.mkdtemp(dir=path.parent))
     script = sumo_home() / "tools" / "randomTrips.py"
     args = [
-        sys.executable, str(script), "-n", str(net_file), "-o", str(tmp / "trips.xml"),
+        sys.executable, str(script), "-n", str(net_file.resolve()), "-o", str(tmp / "trips.xml"),
         "-r", str(tmp / "routes.rou.xml"), "--begin", "0", "--end", str(FLOW_END_S),
         "--insertion-density", f"{density:g}", "--seed", str(TRIPS_SEED),
         "--vehicle-class", "passenger", "--fringe-factor", "5", "--min-distance", "100",
