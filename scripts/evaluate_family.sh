@@ -26,9 +26,9 @@ wanted() { [[ $DRIVERS == *" $1 "* ]]; }
 
 # netgenerate's grid of the worked example in docs/scenario.md: the route A1B1 -> D1E1 runs
 # through the lights B1, C1 and D1; without --demand the env generates trips over the grid.
-NETGENERATE=$("$BIN/python" -c "import sumo, os; print(os.path.join(sumo.SUMO_HOME, 'bin', 'netgenerate'))")
+export SUMO_HOME=${SUMO_HOME:-$("$BIN/python" -c "import sumo; print(sumo.SUMO_HOME)")}
 GRID=$OUT/grid.net.xml
-[[ -f $GRID ]] || "$NETGENERATE" --grid --grid.number 5 --grid.length 200 \
+[[ -f $GRID ]] || "$SUMO_HOME/bin/netgenerate" --grid --grid.number 5 --grid.length 200 \
   --default-junction-type traffic_light --tls.default-type static --no-turnarounds true \
   -o "$GRID" > /dev/null
 
