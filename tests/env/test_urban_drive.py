@@ -209,6 +209,7 @@ def test_info_carries_the_reward_terms(make_env):
         "time",
         "brake",
         "approach",
+        "cruise",
         "total",
     }
     assert terms["total"] == pytest.approx(reward)
