@@ -122,8 +122,8 @@ def _plan(
     ray_address: str | None, seed_tables: list[Path],
 ) -> ReportPlan:  # fmt: skip
     """The report's runs; a bad option ends the command with one line and status 2."""
+    from explaindrive.evaluation.parsing import SpecError, parse_levels
     from explaindrive.evaluation.report import parse_policy_list, plan_report
-    from explaindrive.evaluation.spec import SpecError, parse_levels
 
     problem = grid.check_ray_target(ray, ray_address)
     missing = [p for p in seed_tables if not p.is_file()]

@@ -1,6 +1,7 @@
 """Evaluation suite: episode grids, parallel runners, aggregates, tables, figures and the report.
 
-- :mod:`~explaindrive.evaluation.spec`: policies, seeds, traffic levels and command schedules;
+- :mod:`~explaindrive.evaluation.parsing`: the text formats of seeds, traffic levels and schedules;
+- :mod:`~explaindrive.evaluation.spec`: policies and the episode grids they run over;
 - :mod:`~explaindrive.evaluation.runner`: one episode, and grids on a process pool or Ray;
 - :mod:`~explaindrive.evaluation.aggregate`: aggregation maths (pure functions);
 - :mod:`~explaindrive.evaluation.schema`: the JSON result file;

@@ -24,6 +24,7 @@ from explaindrive.evaluation.paper import (
     PAPER_STOP_SCHEDULE,
     PaperRow,
 )
+from explaindrive.evaluation.parsing import SpecError
 from explaindrive.evaluation.runner import EpisodeRecord, Progress, run_grid, shield_counts
 from explaindrive.evaluation.schema import run_document, write_json
 from explaindrive.evaluation.spec import (
@@ -33,7 +34,6 @@ from explaindrive.evaluation.spec import (
     POLICY_NAMES,
     PolicySpec,
     RunPlan,
-    SpecError,
     parse_policy,
     plan_run,
 )
