@@ -8,5 +8,8 @@
 - :mod:`~explaindrive.evaluation.tables`: Markdown tables in the paper's layout;
 - :mod:`~explaindrive.evaluation.figures`: speed profiles and training curves;
 - :mod:`~explaindrive.evaluation.paper`: the paper's reported numbers (the only copy);
-- :mod:`~explaindrive.evaluation.report`: ``docs/results.md``.
+- :mod:`~explaindrive.evaluation.report_plan`: the runs of ``docs/results.md``;
+- :mod:`~explaindrive.evaluation.report_sections`: its Markdown sections;
+- :mod:`~explaindrive.evaluation.report_discussion`: our numbers against the paper's, in words;
+- :mod:`~explaindrive.evaluation.report`: ``docs/results.md``: runs the plan, writes the figures.
 """
