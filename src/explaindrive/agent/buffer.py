@@ -125,9 +125,16 @@ class ReplayBuffer:
         """Append ``transitions`` in order (:meth:`add` on their columns)."""
         if not transitions:
             return
-        col = Transition(*(np.asarray(c) for c in zip(*transitions, strict=True)))
-        self.add(col.obs, col.action, col.reward, col.next_obs, col.terminated, col.discount,
-                 col.mask, col.next_mask)  # fmt: skip
+        self.add(
+            obs=np.asarray([t.obs for t in transitions]),
+            actions=np.asarray([t.action for t in transitions]),
+            rewards=np.asarray([t.reward for t in transitions]),
+            next_obs=np.asarray([t.next_obs for t in transitions]),
+            terminated=np.asarray([t.terminated for t in transitions]),
+            discount=np.asarray([t.discount for t in transitions]),
+            mask=np.asarray([t.mask for t in transitions]),
+            next_mask=np.asarray([t.next_mask for t in transitions]),
+        )
 
     def sample(self, batch_size: int, rng: np.random.Generator) -> ReplayBatch:
         """Uniform sample with replacement.
