@@ -93,19 +93,13 @@ class RouteGeometry:
         return limit
 
 
-def read_network(net_file: Path) -> Any:
-    """The network as sumolib reads it, with the internal (junction) lanes and the
-    pedestrians' connections (a ``sumolib.net.Net``)."""
-    return sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
-
-
 def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGeometry:
     """Read the ego route's geometry from a network file.
 
     Raises:
         ValueError: if the route is not drivable in the network.
     """
-    net = read_network(net_file)
+    net = sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
     road = _CarLanes.read(net)
     layout = _lay_out(net, road, route_edges, net_file)
     lights = [
