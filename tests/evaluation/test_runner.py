@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from explaindrive.cli.main import app
+from explaindrive.cli.app import app
 from explaindrive.env.actions import action_index
 from explaindrive.evaluation.runner import EpisodeRecord, run_episode, run_grid
 from explaindrive.evaluation.schema import SCHEMA_NAME, run_document, write_json
