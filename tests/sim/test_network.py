@@ -11,13 +11,12 @@ import pytest
 from explaindrive.sim.network import (
     NetworkError,
     demand_begin_s,
-    generated_trips,
     own_network,
     parse_route,
     route_edges,
 )
 from explaindrive.sim.route import load_route_geometry
-from explaindrive.sim.scenario.files import default_scenario
+from explaindrive.sim.scenario.files import default_scenario, generated_trips
 from tests.conftest import GRID_WITH_LIGHTS
 
 
