@@ -28,7 +28,7 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 from explaindrive.commands import Command
 
@@ -305,27 +305,11 @@ class RewardTerms:
     @property
     def total(self) -> float:
         """Sum of the terms."""
-        return math.fsum(
-            (self.ttc, self.headway, self.jerk, self.traffic, self.speed, self.collision,
-             self.stop, self.time, self.brake, self.approach, self.cruise)
-        )  # fmt: skip
+        return math.fsum(getattr(self, f.name) for f in fields(self))
 
     def as_dict(self) -> dict[str, float]:
         """Terms plus ``total`` as a plain dict (for ``info``)."""
-        return {
-            "ttc": self.ttc,
-            "headway": self.headway,
-            "jerk": self.jerk,
-            "traffic": self.traffic,
-            "speed": self.speed,
-            "collision": self.collision,
-            "stop": self.stop,
-            "time": self.time,
-            "brake": self.brake,
-            "approach": self.approach,
-            "cruise": self.cruise,
-            "total": self.total,
-        }
+        return {**{f.name: getattr(self, f.name) for f in fields(self)}, "total": self.total}
 
 
 def _signal_stop(w: RewardWeights, gap_m: float) -> float:
