@@ -139,7 +139,7 @@ def test_passenger_fast_terms():
     t = R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE)
     assert t.ttc == pytest.approx(2 * -0.693147, abs=1e-6)
     assert t.headway == 0.0  # no real leader: a stop line earns no headway reward
-    assert t.jerk == pytest.approx(-0.1 * 4)
+    assert t.jerk == pytest.approx(-0.3 * 4)
     assert t.speed == pytest.approx(3 * 10 / 13.89)
     assert t.time == -0.5
     assert t.brake == -4.0  # 1.0 * (3 - 1)^2
@@ -147,8 +147,8 @@ def test_passenger_fast_terms():
     # in it needs 100 / 1 = 100 m/s^2, capped at 9: 0.3 * 7.5^2 = 16.875
     assert t.approach == pytest.approx(-16.875)
     assert t.cruise == 0.0  # not a free road
-    # -1.386294 - 0.4 + 2.159827 - 0.5 - 4.0 - 16.875 = -21.001467
-    assert t.total == pytest.approx(-21.001467, abs=1e-5)
+    # -1.386294 - 1.2 + 2.159827 - 0.5 - 4.0 - 16.875 = -21.801467
+    assert t.total == pytest.approx(-21.801467, abs=1e-5)
 
 
 def test_passenger_approach_keeps_a_time_gap():
@@ -168,8 +168,9 @@ def test_passenger_approach_keeps_a_time_gap():
 @pytest.mark.parametrize(
     ("speed_mps", "free", "fast", "comfort"),
     [
-        (5.0, True, -3 * (0.8 - 0.5), -5 * (0.8 - 0.5)),  # half the 10 m/s limit
-        (8.0, True, 0.0, 0.0),  # at 80 %
+        (5.0, True, -3 * (0.9 - 0.5), -5 * (0.9 - 0.5)),  # half the 10 m/s limit
+        (8.0, True, -3 * 0.1, -5 * 0.1),  # at 80 %
+        (9.0, True, 0.0, 0.0),  # at 90 %
         (10.0, True, 0.0, 0.0),
         (5.0, False, 0.0, 0.0),  # a leader or a light near: slow is no fault
     ],

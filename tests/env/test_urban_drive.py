@@ -281,6 +281,7 @@ def test_pedestrians_do_not_step_in_front_of_the_ego_at_the_zebra(make_env):
         obs, _ = env.reset(seed=seed, options={"traffic_level": 1.25})
         api, driver = env.sumo, CautiousDriver()
         on_crossing = set(api.edge.getLastStepPersonIDs(zebra.crossing_edge))
+        was_held: set[str] = set()
         for _ in range(400):
             front = env._episode().pos_m
             obs, _, terminated, truncated, info = env.step(driver(obs))
@@ -288,10 +289,11 @@ def test_pedestrians_do_not_step_in_front_of_the_ego_at_the_zebra(make_env):
             now = set(api.edge.getLastStepPersonIDs(zebra.crossing_edge))
             if zebra.stop_line_m <= front and front - length < zebra.end_m:
                 assert now <= on_crossing, (seed, front, now - on_crossing)
-            held = [p for p in api.person.getIDList() if env._episode().kerb.holds(p)]
+            held = {p for p in api.person.getIDList() if env._episode().kerb.holds(p)}
             held_steps += len(held)
-            assert all(api.person.getSpeed(p) == 0.0 for p in held)
-            on_crossing = now
+            # held through the step: they stood still (those held after it stop next step)
+            assert all(api.person.getSpeed(p) == 0.0 for p in held & was_held)
+            on_crossing, was_held = now, held
             if terminated or truncated or front > zebra.end_m + 50.0:
                 break
     assert held_steps > 0  # the rule was exercised
@@ -359,9 +361,9 @@ def test_the_cruise_term_charges_exactly_the_slow_free_road_steps(make_env):
         obs, _r, terminated, truncated, info = env.step(driver(obs))
         share = info["speed_mps"] / info["posted_limit_mps"]
         cruise = info["reward_terms"]["cruise"]
-        if is_free_road(info) and share < 0.8:
+        if is_free_road(info) and share < 0.9:
             slow_free += 1
-            assert cruise == pytest.approx(-5.0 * (0.8 - share))  # comfort's weight
+            assert cruise == pytest.approx(-5.0 * (0.9 - share))  # comfort's weight
         else:
             assert cruise == 0.0
         charged += cruise < 0

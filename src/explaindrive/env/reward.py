@@ -20,7 +20,7 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
   strategy has it, beyond a comfortable 1.5 m/s^2, so the car slows down early; the
   room to stop in keeps a time gap of ``approach_time_gap_s`` at the car's speed, as IDM's
   desired gap does, so that the car eases off before a queue rather than at its tail;
-* driving below 80 % of the limit on a free road is charged (``cruise``): on an open road a
+* driving below 90 % of the limit on a free road is charged (``cruise``): on an open road a
   passenger expects the car to go;
 * comfort's progress is worth as much as fast's: the two differ in smoothness.
 """
@@ -50,7 +50,7 @@ GENTLE_BRAKE_MPS2 = 1.0  # [m/s^2] braking up to this is not charged by ``hard_b
 COMFORT_DECEL_MPS2 = 1.5  # [m/s^2] a stop needing up to this is not charged by ``approach``
 APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
 MAX_NEEDED_MPS2 = 9.0  # [m/s^2] SUMO's emergency braking: ``approach`` charges no further
-CRUISE_SHARE = 0.8  # of the posted limit: ``cruise`` charges free-road driving below it
+CRUISE_SHARE = 0.9  # of the posted limit: ``cruise`` charges free-road driving below it
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,7 +124,7 @@ PASSENGER_RECIPE = RewardRecipe(
         headway_on_stop_lines=False,
         speed=FAST_SPEED_WEIGHT,
         time=0.5,
-        jerk=0.1,
+        jerk=0.3,
         hard_brake=1.0,
         approach=0.3,
         approach_time_gap_s=1.0,

@@ -23,7 +23,13 @@ from numpy.typing import NDArray
 from explaindrive.cache import cache_dir as user_cache_dir
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.actions import N_ACTIONS, STEP_LENGTH_S, speed_change, stopping_need
+from explaindrive.env.actions import (
+    MAX_BRAKE_MPS,
+    N_ACTIONS,
+    STEP_LENGTH_S,
+    speed_change,
+    stopping_need,
+)
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.episode import Episode, StepRecord
 from explaindrive.env.lights import AmberDecision
@@ -307,8 +313,15 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         return motion
 
     def _perceive(self, ego: Any) -> Percept:
-        """What the ego perceives now (``ego``: its subscription results)."""
+        """What the ego perceives now (``ego``: its subscription results).
+
+        Pedestrians who reached a zebra's kerb during the step wait for a car that can no
+        longer stand still before it even braking hardest; the kerb rule holds them before
+        they are seen as stepping out (it ran before the step, when they were not yet there).
+        """
         ep = self._episode()
+        reach = stopping_need(max(ep.speed_mps - MAX_BRAKE_MPS, 0.0))
+        ep.kerb.update(self._sumo.api, self.geometry.crossings, ep.pos_m, self._ego_length_m, reach)
         return ep.perception(self._sumo.api, ego, ep.pos_m, ep.command, ep.amber, ep.kerb)
 
     def _next_observation(
