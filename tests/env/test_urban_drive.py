@@ -8,7 +8,7 @@ from gymnasium.utils.env_checker import check_env
 
 import explaindrive
 from explaindrive.env import state as S
-from explaindrive.env.actions import action_index
+from explaindrive.env.actions import MAX_BRAKE_MPS, action_index, stopping_need
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.metrics import EpisodeMetrics
 from explaindrive.env.ride_quality import is_free_road
@@ -297,6 +297,28 @@ def test_pedestrians_do_not_step_in_front_of_the_ego_at_the_zebra(make_env):
             if terminated or truncated or front > zebra.end_m + 50.0:
                 break
     assert held_steps > 0  # the rule was exercised
+
+
+@pytest.mark.parametrize(("speed", "seed"), [(6, 5), (7, 7)])
+def test_a_pedestrian_reaching_the_kerb_waits_for_a_car_that_cannot_stop(make_env, speed, seed):
+    """On these episodes a pedestrian reaches the zebra's kerb during the step that leaves
+    the car unable to stop before it; they are held at once, not seen stepping out."""
+    env = make_env(traffic_level=0.5, max_steps=400)
+    zebra = next(c for c in env.geometry.crossings if not c.signalized)
+    obs, _ = env.reset(seed=seed)
+    api, driver, checked = env.sumo, ConstantSpeed(speed), 0
+    while True:
+        obs, _, terminated, truncated, _ = env.step(driver(obs))
+        ep = env._episode()
+        reach = stopping_need(max(ep.speed_mps - MAX_BRAKE_MPS, 0.0))
+        if 0.0 < zebra.stop_line_m - ep.pos_m < reach:
+            at_kerb = [p for wa in zebra.walkingareas for p in api.edge.getLastStepPersonIDs(wa)
+                       if api.person.getNextEdge(p) == zebra.crossing_edge]  # fmt: skip
+            assert all(ep.kerb.holds(p) for p in at_kerb), (ep.pos_m, at_kerb)
+            checked += len(at_kerb)
+        if terminated or truncated or ep.pos_m > zebra.end_m:
+            break
+    assert checked > 0  # someone did reach the kerb then
 
 
 def test_noise_reaches_the_observation_and_not_the_judgement(make_env):
