@@ -29,16 +29,8 @@ from explaindrive.language.datasets import (
 )
 from explaindrive.language.encoders import minilm_model_dir
 from explaindrive.language.features import features_from_embeddings, normalize_text
-from explaindrive.language.intent_classifier import (
-    NONE,
-    STOP,
-    Encoded,
-    Hyper,
-    IntentClassifier,
-    Selection,
-    decide_rows,
-    fit_final,
-)
+from explaindrive.language.intent_classifier import NONE, STOP, IntentClassifier, decide_rows
+from explaindrive.language.intent_training import Encoded, Hyper, Selection, fit_final
 
 LOGIT_SCALE = 20.0  # cosine similarities times this are the head's logits
 BATCH = 32

@@ -13,8 +13,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from explaindrive.evaluation.parsing import parse_levels, parse_seeds
 from explaindrive.evaluation.seeds import evaluate_runs, seed_table
-from explaindrive.evaluation.spec import parse_levels, parse_seeds
 from explaindrive.evaluation.sweep import DEFAULT_EVAL_SEEDS
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 

@@ -25,16 +25,8 @@ from rich.table import Table
 from explaindrive.language.datasets import TRAIN_CSV, data_path, load_commands, training_splits
 from explaindrive.language.encoders import RUNTIMES
 from explaindrive.language.features import SentenceEncoder
-from explaindrive.language.intent_classifier import (
-    BUILD_RUNTIME,
-    NONE,
-    STOP,
-    Encoded,
-    Hyper,
-    IntentClassifier,
-    decide_rows,
-    held_out_proba,
-)
+from explaindrive.language.intent_classifier import NONE, STOP, IntentClassifier, decide_rows
+from explaindrive.language.intent_training import BUILD_RUNTIME, Encoded, Hyper, held_out_proba
 
 
 def main() -> None:

@@ -22,7 +22,7 @@ from explaindrive.env.actions import speed_change
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.state import STATE_NAMES
 from explaindrive.env.urban_drive import UrbanDriveEnv
-from explaindrive.evaluation.spec import parse_stop_schedule, stops_to_schedule
+from explaindrive.evaluation.parsing import parse_stop_schedule, stops_to_schedule
 
 VIOLATIONS = ("collision", "red_light_run", "ped_violation")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from explaindrive.agent.buffer import ReplayBuffer, replay_nbytes
+from explaindrive.agent.buffer import ReplayBuffer, Transition, replay_nbytes
 
 
 def _add(buf: ReplayBuffer, start: int, n: int) -> None:
@@ -31,6 +31,24 @@ def test_ring_overwrites_the_oldest() -> None:
     assert (buf.next_mask.sum(axis=1) == 6).all()
     with pytest.raises(ValueError, match="cannot add 5"):
         _add(buf, 0, 5)
+
+
+def test_extend_stores_transitions_as_rollouts_ship_them() -> None:
+    buf = ReplayBuffer(4)
+    safe = np.array([True, True, False, False, False, False, False])
+    steps = [
+        Transition(np.full(8, 1.0), 2, 0.5, np.full(8, 2.0), False, 0.25, safe, ~safe),
+        Transition(np.full(8, 2.0), 6, -1.0, np.full(8, 3.0), True, 0.5, ~safe, safe),
+    ]
+    buf.extend(steps)
+    buf.extend([])  # a round without transitions adds nothing
+    assert (len(buf), buf.pos) == (2, 2)
+    assert buf.obs[:2, 0].tolist() == [1.0, 2.0] and buf.next_obs[:2, 7].tolist() == [2.0, 3.0]
+    assert buf.actions[:2].tolist() == [2, 6] and buf.rewards[:2].tolist() == [0.5, -1.0]
+    assert buf.terminated[:2].tolist() == [False, True]
+    assert buf.discount[:2].tolist() == [0.25, 0.5]
+    assert buf.mask[:2].sum(axis=1).tolist() == [2, 5]
+    assert buf.next_mask[:2].sum(axis=1).tolist() == [5, 2]
 
 
 def test_sample_returns_consistent_rows() -> None:

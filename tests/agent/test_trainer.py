@@ -76,6 +76,20 @@ def test_tiny_run_writes_every_output(tmp_path: Path) -> None:
     assert len(events.Scalars("losses/td_loss")) == 7  # updates 10, 20, ..., 70
 
 
+def test_a_run_is_a_function_of_its_seed(tmp_path: Path) -> None:
+    def run(seed: int, out: str) -> tuple[list[dict[str, str]], dict[str, np.ndarray]]:
+        train(tiny(episodes=5, seed=seed), tmp_path / out, env_factory=FACTORY)
+        table = [{k: v for k, v in r.items() if k != "wall_time_s"} for r in rows(tmp_path / out)]
+        net = QPolicy.load(tmp_path / out / "policy.pt").network
+        return table, {k: v.numpy() for k, v in net.state_dict().items()}
+
+    (table, weights), (again, same) = run(0, "a"), run(0, "b")
+    assert table == again and weights.keys() == same.keys()
+    assert all(np.array_equal(weights[k], same[k]) for k in weights)
+    other, _ = run(1, "c")
+    assert [r["seed"] for r in other] != [r["seed"] for r in table]
+
+
 def test_resume_continues_where_the_run_stopped(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -23,7 +23,7 @@ def test_brackets_in_a_message_are_printed_not_read_as_markup() -> None:
 def test_help_shows_the_units_in_brackets() -> None:
     from typer.testing import CliRunner
 
-    from explaindrive.cli.main import app
+    from explaindrive.cli.app import app
 
     runner = CliRunner()
     assert "Longest ride [s]." in runner.invoke(app, ["ride", "--help"]).output
@@ -60,7 +60,7 @@ def test_every_subcommand_writes_its_error_on_stderr(
 ) -> None:
     from typer.testing import CliRunner
 
-    from explaindrive.cli.main import app
+    from explaindrive.cli.app import app
 
     monkeypatch.chdir(tmp_path)
     result = CliRunner().invoke(app, args)

@@ -8,7 +8,7 @@ import sys
 import pytest
 import typer
 
-from explaindrive.cli.main import COMMANDS, load_command
+from explaindrive.cli.app import COMMANDS, load_command
 
 
 @pytest.mark.parametrize("name", list(COMMANDS))
@@ -36,7 +36,7 @@ def test_the_root_help_imports_no_command() -> None:
 def test_a_mistyped_command_is_answered_with_the_close_ones() -> None:
     from typer.testing import CliRunner
 
-    from explaindrive.cli.main import app
+    from explaindrive.cli.app import app
 
     result = CliRunner().invoke(app, ["traiin"])
     assert result.exit_code == 2

@@ -7,7 +7,7 @@ import importlib.util
 import pytest
 from typer.testing import CliRunner
 
-from explaindrive.cli.main import app
+from explaindrive.cli.app import app
 
 
 @pytest.mark.parametrize(

@@ -121,6 +121,7 @@ def test_stop_reward_terms_only_hold_the_stop_term():
         "time": 0.0,
         "brake": 0.0,
         "approach": 0.0,
+        "cruise": 0.0,
         "total": -50.0,
     }
 
@@ -141,11 +142,43 @@ def test_passenger_fast_terms():
     assert t.jerk == pytest.approx(-0.1 * 4)
     assert t.speed == pytest.approx(3 * 10 / 13.89)
     assert t.time == -0.5
-    assert t.brake == -2.0  # 0.5 * (3 - 1)^2
-    # stopping 10 m/s within 10 - 2 m needs 100 / 16 = 6.25 m/s^2: 0.3 * 4.75^2 = 6.76875
-    assert t.approach == pytest.approx(-6.76875)
-    # -1.386294 - 0.4 + 2.159827 - 0.5 - 2.0 - 6.76875 = -8.895217
-    assert t.total == pytest.approx(-8.895217, abs=1e-5)
+    assert t.brake == -4.0  # 1.0 * (3 - 1)^2
+    # the room keeps 1 s at 10 m/s: 10 - 2 - 10 < 0.5 m, floored at 0.5 m; stopping 10 m/s
+    # in it needs 100 / 1 = 100 m/s^2, capped at 9: 0.3 * 7.5^2 = 16.875
+    assert t.approach == pytest.approx(-16.875)
+    assert t.cruise == 0.0  # not a free road
+    # -1.386294 - 0.4 + 2.159827 - 0.5 - 4.0 - 16.875 = -21.001467
+    assert t.total == pytest.approx(-21.001467, abs=1e-5)
+
+
+def test_passenger_approach_keeps_a_time_gap():
+    # 8 m/s towards a standing queue 40 m ahead: the room is 40 - 2 - 8 = 30 m
+    f = _features(speed_mps=8.0, leader_gap_m=40.0, closing_speed_mps=8.0)
+    t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
+    # 64 / 60 = 1.0667 m/s^2: gentle enough
+    assert t.approach == 0.0
+    f = _features(speed_mps=12.0, leader_gap_m=40.0, closing_speed_mps=12.0)
+    t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
+    # room 40 - 2 - 12 = 26 m; 144 / 52 = 2.769231 m/s^2; 1.0 * 1.269231^2 = 1.610947
+    assert t.approach == pytest.approx(-1.610947, abs=1e-6)
+    # without the time gap: 144 / 76 = 1.894737 m/s^2; 0.394737^2 = 0.155817
+    assert R.approach_penalty(40.0, 12.0, 1.0) == pytest.approx(-0.155817, abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("speed_mps", "free", "fast", "comfort"),
+    [
+        (5.0, True, -3 * (0.8 - 0.5), -5 * (0.8 - 0.5)),  # half the 10 m/s limit
+        (8.0, True, 0.0, 0.0),  # at 80 %
+        (10.0, True, 0.0, 0.0),
+        (5.0, False, 0.0, 0.0),  # a leader or a light near: slow is no fault
+    ],
+)
+def test_passenger_cruise_charges_a_slow_free_road(speed_mps, free, fast, comfort):
+    f = _features(speed_mps=speed_mps, limit_mps=10.0, free_road=free)
+    assert R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE).cruise == pytest.approx(fast)
+    assert R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE).cruise == pytest.approx(comfort)
+    assert R.reward_terms(Command.FAST, f).cruise == 0.0  # the paper's reward has no such term
 
 
 def test_needed_deceleration():

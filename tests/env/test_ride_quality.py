@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from explaindrive.env.ride_quality import RideQuality, is_free_road, signal_stop_kind
+from explaindrive.env.ride_quality import RideQuality, free_road, is_free_road, signal_stop_kind
 from explaindrive.evaluation.aggregate import ride_quality
 
 LIMIT = 10.0
@@ -84,3 +84,19 @@ def test_pooled_figures():
     assert agg["reversals_per_min"] == 0.0  # 1 following step, no reversal
     assert agg["stop_gap_in_window_share"] == 0.5  # 2 m in [1, 5], 8 m not
     assert (agg["light_stops"], agg["crossing_stops"]) == (1, 1)
+
+
+@pytest.mark.parametrize(
+    ("real_gap_m", "red_or_yellow", "light_gap_m", "crossing_gap_m", "free"),
+    [
+        (50.0, False, 10.0, 200.0, True),  # a green light close by does not matter
+        (49.9, False, 200.0, 200.0, False),  # a vehicle within 50 m
+        (200.0, True, 59.9, 200.0, False),  # a red or yellow light within 60 m
+        (200.0, True, 60.0, 200.0, True),
+        (200.0, False, 200.0, 59.9, False),  # a pedestrian on a crossing within 60 m
+    ],
+)
+def test_free_road_is_judged_at_50_m_of_vehicles_and_60_m_of_signals(
+    real_gap_m, red_or_yellow, light_gap_m, crossing_gap_m, free
+):
+    assert free_road(real_gap_m, red_or_yellow, light_gap_m, crossing_gap_m) is free

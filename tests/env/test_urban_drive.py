@@ -11,6 +11,7 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import action_index
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.metrics import EpisodeMetrics
+from explaindrive.env.ride_quality import is_free_road
 from explaindrive.env.scripted import AlwaysAccelerate, CautiousDriver, ConstantSpeed
 from explaindrive.sim.connection import SumoConnection
 
@@ -209,6 +210,7 @@ def test_info_carries_the_reward_terms(make_env):
         "time",
         "brake",
         "approach",
+        "cruise",
         "total",
     }
     assert terms["total"] == pytest.approx(reward)
@@ -347,3 +349,22 @@ def test_a_blocked_entry_at_175_drops_the_queue_after_30_s(tmp_path) -> None:
         assert env.sumo.simulation.getTime() == 180 + 32
     finally:
         env.close()
+
+
+def test_the_cruise_term_charges_exactly_the_slow_free_road_steps(make_env):
+    env = make_env(reward="passenger", traffic_level=0.5, max_steps=120)
+    obs, _ = env.reset(seed=3, options={"command": "comfort"})
+    driver, charged, slow_free = CautiousDriver(), 0, 0
+    for _ in range(120):
+        obs, _r, terminated, truncated, info = env.step(driver(obs))
+        share = info["speed_mps"] / info["posted_limit_mps"]
+        cruise = info["reward_terms"]["cruise"]
+        if is_free_road(info) and share < 0.8:
+            slow_free += 1
+            assert cruise == pytest.approx(-5.0 * (0.8 - share))  # comfort's weight
+        else:
+            assert cruise == 0.0
+        charged += cruise < 0
+        if terminated or truncated:
+            break
+    assert charged == slow_free > 0  # the start from standstill is slow on a free road

@@ -99,7 +99,7 @@ def test_tables_show_ours_next_to_the_paper() -> None:
 
 
 def test_discussion_is_computed_from_the_numbers() -> None:
-    from explaindrive.evaluation.report import discussion
+    from explaindrive.evaluation.report_discussion import discussion
 
     fast = RunSummary("fast", aggregate([A]), aggregate_by_level([(0.5, A)]))
     comfort = RunSummary("comfort", aggregate([C]), aggregate_by_level([(0.5, C)]))

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from explaindrive.cli.main import app
+from explaindrive.cli.app import app
 from explaindrive.env.actions import action_index
 from explaindrive.evaluation.runner import EpisodeRecord, run_episode, run_grid
 from explaindrive.evaluation.schema import SCHEMA_NAME, run_document, write_json
@@ -127,7 +127,8 @@ def test_evaluate_cli_errors(args: list[str], message: str) -> None:
 
 
 def test_report_document(tmp_path: Path, policies: tuple[Path, Path]) -> None:
-    from explaindrive.evaluation.report import plan_report, run_report
+    from explaindrive.evaluation.report import run_report
+    from explaindrive.evaluation.report_plan import plan_report
 
     plan = plan_report(["merged"], (0,), (0.5,), merged_level=0.5, fast_path=policies[0],
                        comfort_path=policies[1], max_steps=MAX_STEPS)  # fmt: skip

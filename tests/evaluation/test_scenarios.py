@@ -6,8 +6,9 @@ from pathlib import Path
 
 import pytest
 
+from explaindrive.evaluation.parsing import SpecError
 from explaindrive.evaluation.scenarios import over_scenarios, parse_scenarios
-from explaindrive.evaluation.spec import SpecError, parse_policy, plan_run
+from explaindrive.evaluation.spec import parse_policy, plan_run
 
 
 def test_held_out_scenarios_repeat_the_grid(tmp_path: Path) -> None:

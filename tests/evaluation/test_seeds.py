@@ -28,7 +28,7 @@ def test_seed_table_lists_each_run_then_mean_and_spread() -> None:
 
 
 def test_report_includes_seed_tables_under_their_run_folder(tmp_path) -> None:  # type: ignore[no-untyped-def]
-    from explaindrive.evaluation.report import seeds_section
+    from explaindrive.evaluation.report_sections import seeds_section
 
     table = tmp_path / "fast-seeds" / "seeds.md"
     table.parent.mkdir()

@@ -12,7 +12,7 @@ import pytest
 from tests.language.test_replies import CHATTY_COMFORT
 from typer.testing import CliRunner
 
-from explaindrive.cli.main import app
+from explaindrive.cli.app import app
 from explaindrive.commands import Command
 from explaindrive.language.backends.embedded import (
     EmbeddedIntentInterpreter,

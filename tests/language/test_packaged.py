@@ -64,7 +64,7 @@ def test_transcribe_refuses_tampered_weights_in_one_line(
 
     from typer.testing import CliRunner
 
-    from explaindrive.cli.main import app
+    from explaindrive.cli.app import app
 
     (fake_package / "model.bin").write_bytes(b"tampered")
     monkeypatch.setattr("explaindrive.language.speech.WHISPER_TINY_EN", TOY)

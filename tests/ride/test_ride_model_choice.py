@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from explaindrive.cli.main import app
+from explaindrive.cli.app import app
 from tests.language.conftest import ScriptedOpenAI
 
 runner = CliRunner()

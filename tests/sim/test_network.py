@@ -16,7 +16,7 @@ from explaindrive.sim.network import (
     route_edges,
 )
 from explaindrive.sim.route import load_route_geometry
-from explaindrive.sim.scenario.files import default_scenario
+from explaindrive.sim.scenario.files import default_scenario, generated_trips
 from tests.conftest import GRID_WITH_LIGHTS
 
 
@@ -122,3 +122,12 @@ def test_guessed_crossings_are_read_along_the_route(netgen: Callable[..., Path])
     assert all(c.signalized for c in geometry.crossings)
     stops = sorted({c.stop_line_m for c in geometry.crossings})
     assert stops == [light.stop_line_m for light in geometry.lights]
+
+
+def test_trips_are_made_for_a_network_named_relative_to_the_working_directory(
+    netgen: Callable[..., Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    net = netgen("grid", *GRID_WITH_LIGHTS)
+    monkeypatch.chdir(net.parent)
+    trips = generated_trips(Path(net.name), tmp_path / "cache")
+    assert trips.is_file() and "<vehicle" in trips.read_text()

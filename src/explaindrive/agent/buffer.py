@@ -18,6 +18,7 @@ The arrays are allocated with ``np.zeros`` so untouched pages cost no resident m
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -30,6 +31,19 @@ from explaindrive.env.state import STATE_DIM
 def replay_nbytes(capacity: int, state_dim: int = STATE_DIM) -> int:
     """Bytes held by a :class:`ReplayBuffer` of ``capacity`` transitions."""
     return capacity * (2 * state_dim * 4 + 1 + 4 + 4 + 1 + 2 * N_ACTIONS)
+
+
+class Transition(NamedTuple):
+    """One n-step transition, as a rollout worker ships it."""
+
+    obs: NDArray[np.float32]
+    action: int
+    reward: float  # the discounted n-step return
+    next_obs: NDArray[np.float32]
+    terminated: bool
+    discount: float  # gamma^n
+    mask: NDArray[np.bool_]  # the safe actions of obs
+    next_mask: NDArray[np.bool_]  # the safe actions of next_obs
 
 
 class ReplayBatch(NamedTuple):
@@ -106,6 +120,21 @@ class ReplayBuffer:
             target[idx] = True if value is None else np.asarray(value).reshape(n, N_ACTIONS)
         self.pos = int((self.pos + n) % self.capacity)
         self.size = min(self.size + n, self.capacity)
+
+    def extend(self, transitions: Sequence[Transition]) -> None:
+        """Append ``transitions`` in order (:meth:`add` on their columns)."""
+        if not transitions:
+            return
+        self.add(
+            obs=np.asarray([t.obs for t in transitions]),
+            actions=np.asarray([t.action for t in transitions]),
+            rewards=np.asarray([t.reward for t in transitions]),
+            next_obs=np.asarray([t.next_obs for t in transitions]),
+            terminated=np.asarray([t.terminated for t in transitions]),
+            discount=np.asarray([t.discount for t in transitions]),
+            mask=np.asarray([t.mask for t in transitions]),
+            next_mask=np.asarray([t.next_mask for t in transitions]),
+        )
 
     def sample(self, batch_size: int, rng: np.random.Generator) -> ReplayBatch:
         """Uniform sample with replacement.

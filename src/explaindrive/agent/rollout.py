@@ -25,6 +25,7 @@ import gymnasium as gym
 import numpy as np
 import torch
 
+from explaindrive.agent.buffer import Transition
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
@@ -73,10 +74,6 @@ def default_env_factory(config: TrainConfig) -> EnvFactory:
         config.scenario_fields(),
         config.reward,
     )
-
-
-Transition = tuple[np.ndarray, int, float, np.ndarray, bool, float, np.ndarray, np.ndarray]
-"""(obs, action, return, next_obs, terminated, discount, mask, next_mask)"""
 
 
 def _true_state(obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
@@ -129,8 +126,8 @@ class NStepQueue:
             ret = sum(self.gamma**k * step[2] for k, step in enumerate(self._steps))
             first_obs, first_action, _, first_mask = self._steps.popleft()
             discount = self.gamma ** (len(self._steps) + 1)
-            out.append((first_obs, first_action, ret, next_obs, terminated and done, discount,
-                        first_mask, next_mask))  # fmt: skip
+            out.append(Transition(first_obs, first_action, ret, next_obs, terminated and done,
+                                  discount, first_mask, next_mask))  # fmt: skip
         return out
 
 

@@ -1,5 +1,6 @@
 """What a training run writes as it goes: ``episodes.csv``, TensorBoard scalars, a progress
-bar, and the training-curve figure at the end."""
+bar and ``train.log`` (:class:`RunLog`, :func:`note`), and the training-curve figure at the
+end."""
 
 from __future__ import annotations
 
@@ -7,11 +8,13 @@ import csv
 import importlib.util
 import logging
 import subprocess
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.rollout import EpisodeSummary
 from explaindrive.extras import install_line
 
@@ -176,3 +179,70 @@ class Progress:
         """Remove the bar."""
         if self._progress is not None:
             self._progress.stop()
+
+
+def note(out_dir: Path, level: int, message: str, *args: object) -> None:
+    """Log ``message % args`` and append it, stamped, to ``out_dir/train.log``."""
+    log.log(level, message, *args)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stamp = datetime.now(UTC).isoformat(timespec="seconds")
+    with (out_dir / "train.log").open("a", encoding="utf-8") as f:
+        f.write(f"{stamp} {logging.getLevelName(level)} {message % args}\n")
+
+
+class RunLog:
+    """The outputs a run writes as it goes: ``episodes.csv``, TensorBoard and the bar.
+
+    Args:
+        out_dir: the run directory.
+        config: the run's config.
+        append: continue ``episodes.csv`` (a resumed run) instead of writing it afresh.
+        env_steps: the steps played so far (TensorBoard drops any scalars logged after them).
+        episodes_done: the episodes finished so far (where the bar starts).
+        show_progress: draw the rich progress bar.
+    """
+
+    def __init__(
+        self, out_dir: Path, config: TrainConfig, *, append: bool, env_steps: int,
+        episodes_done: int, show_progress: bool,
+    ) -> None:  # fmt: skip
+        self.config = config
+        csv_path = out_dir / "episodes.csv"
+        append = append and csv_path.exists()
+        self._csv_file = csv_path.open("a" if append else "w", newline="")
+        self._csv = csv.DictWriter(self._csv_file, fieldnames=CSV_FIELDS)
+        if not append:
+            self._csv.writeheader()
+        self.tb = scalar_writer(out_dir / "tb", purge_step=env_steps or None)
+        title = f"train {config.mode}"
+        self._progress = Progress(show_progress, config.episodes, episodes_done, title)
+
+    def episode(
+        self, ep: EpisodeSummary, worker: int, *, env_steps: int, epsilon: float,
+        wall_time_s: float, steps_per_s: float, episodes_done: int, mean_return: float,
+    ) -> None:  # fmt: skip
+        """A finished episode: its CSV row, its TensorBoard scalars and the bar."""
+        self._csv.writerow(csv_row(ep, worker, env_steps, epsilon, wall_time_s))
+        tb_episode(self.tb, ep, env_steps, epsilon, steps_per_s)
+        self._progress.update(episodes_done, ep.ret, mean_return, epsilon, steps_per_s)
+
+    def losses(self, stats: dict[str, float], step: int) -> None:
+        """The TensorBoard scalars of a learner update (its ``stats``) at env step ``step``."""
+        c = self.config
+        self.tb.add_scalar("losses/td_loss", stats["td_loss"], step)
+        self.tb.add_scalar("losses/q_values", stats["q_values"], step)
+        self.tb.add_scalar("charts/learning_rate", stats["learning_rate"], step)
+        if c.safe_learning:
+            self.tb.add_scalar("losses/unsafe_loss", stats["unsafe_loss"], step)
+        if c.grad_clip_norm is not None:
+            self.tb.add_scalar("losses/grad_norm", stats["grad_norm"], step)
+
+    def flush(self) -> None:
+        """Write the CSV rows so far to disk."""
+        self._csv_file.flush()
+
+    def close(self) -> None:
+        """Remove the bar and close the files."""
+        self._progress.close()
+        self.tb.close()
+        self._csv_file.close()

@@ -1,1 +1,1 @@
-"""Command-line interface: one module per command, assembled in :mod:`explaindrive.cli.main`."""
+"""Command-line interface: one module per command, assembled in :mod:`explaindrive.cli.app`."""

@@ -41,7 +41,7 @@ def main() -> None:
         from typer import Abort
         from typer._click.exceptions import ClickException, NoArgsIsHelpError
 
-        from explaindrive.cli.main import app
+        from explaindrive.cli.app import app
 
         try:
             result = app(standalone_mode=False)  # errors are reported here, on one line

@@ -82,13 +82,9 @@ def evaluate_command(
     demand: where.DemandOption = None,
 ) -> None:
     """Evaluate a policy or a SUMO baseline; prints Markdown tables in the paper's layout."""
+    from explaindrive.evaluation.parsing import parse_levels, parse_seeds
     from explaindrive.evaluation.schema import run_document, write_json
-    from explaindrive.evaluation.spec import (
-        parse_levels,
-        parse_policy,
-        parse_seeds,
-        plan_run,
-    )
+    from explaindrive.evaluation.spec import parse_policy, plan_run
 
     refuse_bad_outputs(files=((json_file, "--json"),), folders=((figures, "--figures"),))
     try:

@@ -17,7 +17,7 @@ from explaindrive.evaluation.spec import POLICY_NAMES
 from explaindrive.limits import MAX_SEEDS
 
 if TYPE_CHECKING:
-    from explaindrive.evaluation.report import ReportPlan
+    from explaindrive.evaluation.report_plan import ReportPlan
 
 
 ALL_POLICIES = ",".join(POLICY_NAMES)
@@ -122,8 +122,8 @@ def _plan(
     ray_address: str | None, seed_tables: list[Path],
 ) -> ReportPlan:  # fmt: skip
     """The report's runs; a bad option ends the command with one line and status 2."""
-    from explaindrive.evaluation.report import parse_policy_list, plan_report
-    from explaindrive.evaluation.spec import SpecError, parse_levels
+    from explaindrive.evaluation.parsing import SpecError, parse_levels
+    from explaindrive.evaluation.report_plan import parse_policy_list, plan_report
 
     problem = grid.check_ray_target(ray, ray_address)
     missing = [p for p in seed_tables if not p.is_file()]

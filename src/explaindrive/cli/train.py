@@ -237,7 +237,7 @@ def _train_seeds(
     """``--seeds``: one run per seed, then the combined table
     (:mod:`explaindrive.evaluation.sweep`)."""
     from explaindrive.agent.config import ConfigError
-    from explaindrive.evaluation.spec import SpecError, parse_seeds
+    from explaindrive.evaluation.parsing import SpecError, parse_seeds
     from explaindrive.evaluation.sweep import (
         DEFAULT_EVAL_SEEDS,
         DEFAULT_EVAL_STOPS,

@@ -88,6 +88,8 @@ class StepRecord:
         real: the real leader after the step.
         limit_mps: the posted limit the agent observed before the step.
         violations: the stop-line violations of the step.
+        free_road: the road ahead is free after the step
+            (:func:`explaindrive.env.ride_quality.free_road`).
     """
 
     command: Command
@@ -99,6 +101,7 @@ class StepRecord:
     real: Leader | None
     limit_mps: float
     violations: Violations
+    free_road: bool = False
 
     @property
     def ttc_s(self) -> float:
@@ -127,6 +130,7 @@ class StepRecord:
             accel_mps2=self.accel,
             leader_gap_m=leader.gap_m if leader else math.inf,
             closing_speed_mps=v - leader.speed_mps if leader else 0.0,
+            free_road=self.free_road,
         )
 
     def info(

@@ -17,7 +17,11 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
   (``hard_brake``), more under comfort;
 * closing in on a leader, a red light or a pedestrian too fast to stop gently is charged
   (``approach``): the deceleration that would just stop in time, as IDM's braking
-  strategy has it, beyond a comfortable 1.5 m/s^2, so the car slows down early;
+  strategy has it, beyond a comfortable 1.5 m/s^2, so the car slows down early; the
+  room to stop in keeps a time gap of ``approach_time_gap_s`` at the car's speed, as IDM's
+  desired gap does, so that the car eases off before a queue rather than at its tail;
+* driving below 80 % of the limit on a free road is charged (``cruise``): on an open road a
+  passenger expects the car to go;
 * comfort's progress is worth as much as fast's: the two differ in smoothness.
 """
 
@@ -45,6 +49,8 @@ STOP_REASON_GAP_M = 15.0  # [m] a leader this close justifies standing still
 GENTLE_BRAKE_MPS2 = 1.0  # [m/s^2] braking up to this is not charged by ``hard_brake``
 COMFORT_DECEL_MPS2 = 1.5  # [m/s^2] a stop needing up to this is not charged by ``approach``
 APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
+MAX_NEEDED_MPS2 = 9.0  # [m/s^2] SUMO's emergency braking: ``approach`` charges no further
+CRUISE_SHARE = 0.8  # of the posted limit: ``cruise`` charges free-road driving below it
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,6 +68,9 @@ class RewardWeights:
         hard_brake: weight of -(braking beyond :data:`GENTLE_BRAKE_MPS2`)^2.
         approach: weight of -(needed deceleration beyond :data:`COMFORT_DECEL_MPS2`)^2
             (:func:`approach_penalty`).
+        approach_time_gap_s: the time gap [s] at the car's speed that the approach keeps
+            clear of the obstacle besides :data:`APPROACH_STANDSTILL_M`.
+        cruise: weight of -(:data:`CRUISE_SHARE` - v / v_lim) on a free road below it.
         signal_stop: paid per step standing for a light or a pedestrian.
         stop_window_m: ``(min, max)`` distance to the line within which ``signal_stop`` is
             paid; ``None`` pays it at any distance (the paper).
@@ -75,6 +84,8 @@ class RewardWeights:
     jerk: float = 0.0
     hard_brake: float = 0.0
     approach: float = 0.0
+    approach_time_gap_s: float = 0.0
+    cruise: float = 0.0
     signal_stop: float = R_RESPECT
     stop_window_m: tuple[float, float] | None = None
 
@@ -114,8 +125,10 @@ PASSENGER_RECIPE = RewardRecipe(
         speed=FAST_SPEED_WEIGHT,
         time=0.5,
         jerk=0.1,
-        hard_brake=0.5,
+        hard_brake=1.0,
         approach=0.3,
+        approach_time_gap_s=1.0,
+        cruise=3.0,
         signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
     ),
@@ -125,8 +138,10 @@ PASSENGER_RECIPE = RewardRecipe(
         speed=FAST_SPEED_WEIGHT,
         time=0.5,
         jerk=1.0,
-        hard_brake=1.0,
-        approach=0.5,
+        hard_brake=2.0,
+        approach=1.0,
+        approach_time_gap_s=1.0,
+        cruise=5.0,
         signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
     ),
@@ -210,20 +225,31 @@ def hard_brake_penalty(accel_mps2: float, weight: float) -> float:
     return -weight * excess * excess
 
 
-def needed_deceleration(gap_m: float, closing_speed_mps: float) -> float:
+def needed_deceleration(gap_m: float, closing_speed_mps: float, keep_m: float = 0.0) -> float:
     """The constant deceleration [m/s^2] that just stops the closing-in before the gap
-    shrinks to :data:`APPROACH_STANDSTILL_M`: dv^2 / (2 (gap - s0)) (IDM's kinematic
-    deceleration); 0 when not closing in, and the gap floored at 0.5 m."""
+    shrinks to :data:`APPROACH_STANDSTILL_M` plus ``keep_m``: dv^2 / (2 (gap - s0 - keep))
+    (IDM's kinematic deceleration); 0 when not closing in, and the room floored at 0.5 m."""
     if closing_speed_mps <= 0.0 or not math.isfinite(gap_m):
         return 0.0
-    room = max(gap_m - APPROACH_STANDSTILL_M, 0.5)
+    room = max(gap_m - APPROACH_STANDSTILL_M - keep_m, 0.5)
     return closing_speed_mps * closing_speed_mps / (2.0 * room)
 
 
-def approach_penalty(gap_m: float, closing_speed_mps: float, weight: float) -> float:
-    """-weight * (needed deceleration beyond :data:`COMFORT_DECEL_MPS2`)^2."""
-    excess = max(0.0, needed_deceleration(gap_m, closing_speed_mps) - COMFORT_DECEL_MPS2)
+def approach_penalty(
+    gap_m: float, closing_speed_mps: float, weight: float, keep_m: float = 0.0
+) -> float:
+    """-weight * (needed deceleration beyond :data:`COMFORT_DECEL_MPS2`)^2, stopping
+    ``keep_m`` short of the standstill gap; the need is capped at :data:`MAX_NEEDED_MPS2`."""
+    needed = min(needed_deceleration(gap_m, closing_speed_mps, keep_m), MAX_NEEDED_MPS2)
+    excess = max(0.0, needed - COMFORT_DECEL_MPS2)
     return -weight * excess * excess
+
+
+def cruise_penalty(speed_mps: float, limit_mps: float, free_road: bool, weight: float) -> float:
+    """-weight * (:data:`CRUISE_SHARE` - v / v_lim) on a free road below that share, else 0."""
+    if not free_road or limit_mps <= 0.0:
+        return 0.0
+    return -weight * max(0.0, CRUISE_SHARE - speed_mps / limit_mps)
 
 
 def collision_reward(collided: bool) -> float:
@@ -257,6 +283,7 @@ class StepFeatures:
     accel_mps2: float | None = None  # the step's speed change as driven; None: the action's
     leader_gap_m: float = math.inf  # gap to the effective leader after the step [m]
     closing_speed_mps: float = 0.0  # ego speed minus the effective leader's, after the step
+    free_road: bool = False  # as the ride-quality figures define it (env/ride_quality.py)
 
 
 @dataclass(frozen=True, slots=True)
@@ -273,13 +300,14 @@ class RewardTerms:
     time: float = 0.0
     brake: float = 0.0
     approach: float = 0.0
+    cruise: float = 0.0
 
     @property
     def total(self) -> float:
         """Sum of the terms."""
         return math.fsum(
             (self.ttc, self.headway, self.jerk, self.traffic, self.speed, self.collision,
-             self.stop, self.time, self.brake, self.approach)
+             self.stop, self.time, self.brake, self.approach, self.cruise)
         )  # fmt: skip
 
     def as_dict(self) -> dict[str, float]:
@@ -295,6 +323,7 @@ class RewardTerms:
             "time": self.time,
             "brake": self.brake,
             "approach": self.approach,
+            "cruise": self.cruise,
             "total": self.total,
         }
 
@@ -330,5 +359,8 @@ def reward_terms(
         collision=collision_reward(f.collided),
         time=-w.time,
         brake=hard_brake_penalty(accel, w.hard_brake),
-        approach=approach_penalty(f.leader_gap_m, f.closing_speed_mps, w.approach),
+        approach=approach_penalty(
+            f.leader_gap_m, f.closing_speed_mps, w.approach, w.approach_time_gap_s * f.speed_mps
+        ),
+        cruise=cruise_penalty(f.speed_mps, f.limit_mps, f.free_road, w.cruise),
     )

@@ -66,13 +66,24 @@ class RideQualityResult:
         return d
 
 
-def is_free_road(info: dict[str, Any]) -> bool:
+def free_road(real_gap_m: float, light_red_or_yellow: bool, light_gap_m: float,
+              crossing_gap_m: float) -> bool:  # fmt: skip
     """No vehicle within 50 m, no red/yellow light or busy crossing within 60 m."""
-    if float(info["real_gap_m"]) < FREE_ROAD_VEHICLE_M:
+    if real_gap_m < FREE_ROAD_VEHICLE_M:
         return False
-    if info["light_state"] != "green" and float(info["light_gap_m"]) < FREE_ROAD_SIGNAL_M:
+    if light_red_or_yellow and light_gap_m < FREE_ROAD_SIGNAL_M:
         return False
-    return float(info["crossing_gap_m"]) >= FREE_ROAD_SIGNAL_M
+    return crossing_gap_m >= FREE_ROAD_SIGNAL_M
+
+
+def is_free_road(info: dict[str, Any]) -> bool:
+    """:func:`free_road` of a step's ``info``."""
+    return free_road(
+        float(info["real_gap_m"]),
+        info["light_state"] != "green",
+        float(info["light_gap_m"]),
+        float(info["crossing_gap_m"]),
+    )
 
 
 def signal_stop_kind(info: dict[str, Any]) -> str | None:

@@ -11,6 +11,7 @@ warm-up, the ego's entry), :mod:`~explaindrive.env.perception` (the observation)
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -30,6 +31,7 @@ from explaindrive.env.options import ResetOptions
 from explaindrive.env.perception import LeaderSensor, Percept, Perception
 from explaindrive.env.render import TopDownView
 from explaindrive.env.reward import RECIPES, RewardTerms, reward_terms
+from explaindrive.env.ride_quality import free_road
 from explaindrive.env.safety import runtime_mask
 from explaindrive.env.sumo_process import SUMO_DRIVES, EgoEntry, Motion, SumoProcess
 from explaindrive.env.violations import ViolationJudge
@@ -226,6 +228,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         step = StepRecord(
             command=cmd, change=change, accel=accel, jerk=jerk, motion=motion, leader=leader,
             real=real, limit_mps=float(prev_obs[S.V_LIM]), violations=violations,
+            free_road=free_road(
+                real.gap_m if real else math.inf, int(obs[S.TLS]) != S.LightState.GREEN,
+                float(obs[S.D_TL]), float(obs[S.D_CROSS]),
+            ),
         )  # fmt: skip
         terms = self._reward(step)
         terminated = self._is_terminated(motion)

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from explaindrive.evaluation.spec import RunPlan, SpecError, parse_seeds
+from explaindrive.evaluation.parsing import SpecError, parse_seeds
+from explaindrive.evaluation.spec import RunPlan
 
 RANDOM_PREFIX = "random:"
 

@@ -12,7 +12,7 @@ The ``split`` column of :data:`TRAIN_CSV` says what building LLM-1 does with a r
 * ``dev-1`` ... ``dev-N``: the development splits. For the choice of hyper-parameters, the
   STOP threshold and the none margin, each is predicted by a model fitted on ``train`` and
   the other development splits; the shipped model is then fitted on ``train`` and all of
-  them (:mod:`explaindrive.language.intent_classifier`).
+  them (:mod:`explaindrive.language.intent_training`).
 * ``reserve``: neither fitted on nor used for choices by the shipped model; free for checks
   and for a later model's development.
 """

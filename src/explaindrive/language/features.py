@@ -188,7 +188,7 @@ def features_from_embeddings(
         raise ValueError(
             f"classifier expects {spec.hash_features} hashed features and {spec.n_cues} cues, "
             f"this code builds {HASH_FEATURES} and {N_CUES}; retrain with "
-            "`python -m explaindrive.language.intent_classifier`"
+            "`python -m explaindrive.language.intent_training`"
         )
     return np.hstack(
         [emb, spec.ngram_weight * ngram_features(texts), spec.cue_weight * cue_features(texts)]

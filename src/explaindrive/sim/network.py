@@ -5,35 +5,23 @@ its stop lines, crossings and speed limits are then read along that route
 (:mod:`explaindrive.sim.route`). The background demand is a route file of your own,
 starting wherever its first departure is (e.g. 25200 s, 7:00), which the traffic level
 scales (SUMO's ``--scale``; 1.0 is the file as given), or else trips that SUMO's
-``randomTrips.py`` generates over the whole network, :data:`TRIPS_PER_HOUR_PER_KM` times
-the traffic level.
+``randomTrips.py`` generates over the whole network,
+:data:`~explaindrive.sim.scenario.files.TRIPS_PER_HOUR_PER_KM` times the traffic level
+(:func:`~explaindrive.sim.scenario.files.generated_trips`, which the scenario's files call
+for each level).
 """
 
 from __future__ import annotations
 
-import hashlib
 import logging
-import os
-import subprocess
-import sys
-import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from explaindrive.sim.scenario.files import FLOW_END_S, ScenarioFiles
-from explaindrive.sim.sumo_home import sumo_home
+from explaindrive.sim.scenario.files import NetworkError, ScenarioFiles, generated_trips
 
 log = logging.getLogger(__name__)
 
-TRIPS_PER_HOUR_PER_KM = 60.0
-"""[veh/h per km of lane] generated background trips at traffic level 1.0."""
-TRIPS_SEED = 42
-"""Seed of the generated trips (the episode seed varies the simulation itself)."""
 _DEPART_TAGS = ("vehicle", "trip", "flow", "person", "personFlow")
-
-
-class NetworkError(ValueError):
-    """A network, route or demand file that cannot be used; the message names why."""
 
 
 def check_network_file(net_file: Path) -> None:
@@ -108,41 +96,6 @@ def demand_begin_s(demand_file: Path) -> float:
     except ET.ParseError as exc:
         raise NetworkError(f"demand file {demand_file} is not XML: {exc}") from None
     return 0.0 if first == float("inf") else first
-
-
-def generated_trips(net_file: Path, cache_dir: Path, traffic_level: float = 1.0) -> Path:
-    """Background trips over the whole network at a traffic level, made once per network and
-    level with ``randomTrips.py`` and cached.
-
-    Raises:
-        NetworkError: if randomTrips fails (e.g. no two edges are connected).
-    """
-    digest = hashlib.sha1(net_file.read_bytes()).hexdigest()[:10]
-    density = TRIPS_PER_HOUR_PER_KM * traffic_level  # [veh/h per km of lane]
-    path = cache_dir / "trips" / f"{digest}_{density:g}.rou.xml"
-    if path.exists():
-        return path
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(dir=path.parent))
-    script = sumo_home() / "tools" / "randomTrips.py"
-    args = [
-        sys.executable, str(script), "-n", str(net_file), "-o", str(tmp / "trips.xml"),
-        "-r", str(tmp / "routes.rou.xml"), "--begin", "0", "--end", str(FLOW_END_S),
-        "--insertion-density", f"{density:g}", "--seed", str(TRIPS_SEED),
-        "--vehicle-class", "passenger", "--fringe-factor", "5", "--min-distance", "100",
-        "--prefix", "bg", "--validate",
-        "--trip-attributes", 'departLane="best" departSpeed="max"',
-    ]  # fmt: skip
-    proc = subprocess.run(args, capture_output=True, text=True, check=False, cwd=tmp)
-    routes = tmp / "routes.rou.xml"
-    if proc.returncode != 0 or not routes.is_file():
-        detail = (proc.stderr or proc.stdout).strip().splitlines()[-1:] or ["no output"]
-        raise NetworkError(f"randomTrips.py could not make trips for {net_file}: {detail[0]}")
-    os.replace(routes, path)
-    for leftover in tmp.iterdir():
-        leftover.unlink()
-    tmp.rmdir()
-    return path
 
 
 def own_network(

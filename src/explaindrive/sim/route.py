@@ -2,7 +2,9 @@
 crossings and speed-limit zones measured along the route.
 
 Route positions are in metres from the start of the first route edge and
-include the internal (junction) lanes, so they match SUMO's odometer.
+include the internal (junction) lanes, so they match SUMO's odometer. The network is read
+with sumolib, as the scene (:mod:`explaindrive.sim.scene`) and the crossing lanes
+(:mod:`explaindrive.sim.crossing_lanes`) read it.
 """
 
 from __future__ import annotations
@@ -10,9 +12,12 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
-import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+
+import sumolib
 
 POSTED_DECEL_MPS2 = 0.75  # [m/s^2] the posted limit ramps down to a lower zone at this rate
 
@@ -88,35 +93,24 @@ class RouteGeometry:
         return limit
 
 
-def _lane_lengths(root: ET.Element) -> dict[str, tuple[float, float]]:
-    out: dict[str, tuple[float, float]] = {}
-    for edge in root.iter("edge"):
-        for lane in edge.iter("lane"):
-            out[lane.attrib["id"]] = (float(lane.attrib["length"]), float(lane.attrib["speed"]))
-    return out
-
-
 def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGeometry:
     """Read the ego route's geometry from a network file.
 
     Raises:
         ValueError: if the route is not drivable in the network.
     """
-    root = ET.parse(net_file).getroot()
-    net = _Network.read(root)
-    layout = _lay_out(net, route_edges, net_file)
-    edge_to = {e.attrib["id"]: e.get("to") for e in root.iter("edge") if not e.get("function")}
-    nodes = {j.attrib["id"]: j for j in root.iter("junction")}
+    net = sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
+    road = _CarLanes.read(net)
+    layout = _lay_out(net, road, route_edges, net_file)
     lights = [
         RouteLight(
             tls_id=tls_id,
             stop_line_m=layout.end[eid],
-            lane_links=tuple(net.links.get((eid, nxt), ())),
+            lane_links=tuple(road.links.get((eid, nxt), ())),
         )
         for eid, nxt in itertools.pairwise(route_edges)
-        if (tls_id := net.conns[(eid, nxt)].get("tl"))
+        if (tls_id := road.conns[(eid, nxt)].getTLSID())
     ]
-    crossings = _route_crossings(root, route_edges, edge_to, nodes, layout)
     return RouteGeometry(
         edges=tuple(route_edges),
         edge_start_m=tuple(layout.starts),
@@ -124,56 +118,46 @@ def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGe
         zone_start_m=tuple(layout.zone_start),
         zone_limit_mps=tuple(layout.zone_limit),
         lights=tuple(lights),
-        crossings=tuple(crossings),
+        crossings=tuple(_route_crossings(net, route_edges, layout)),
     )
 
 
 @dataclass
-class _Network:
-    """What the route layout needs from a network file."""
+class _CarLanes:
+    """Where a route of cars runs in a network: its lane on each edge and its connections.
 
-    lanes: dict[str, tuple[float, float]]  # lane -> (length, speed limit)
-    edge_lane: dict[str, str]  # normal edge -> its vehicle lane
-    conns: dict[tuple[str, str], ET.Element]  # (edge, next edge) -> connection with a via lane
-    via_next: dict[str, str]  # internal lane -> the next internal lane
+    sumolib's lanes, connections and edges are untyped, hence ``Any``.
+    """
+
+    edge_lane: dict[str, Any]  # normal edge -> its leftmost car lane
+    conns: dict[tuple[str, str], Any]  # (edge, next edge) -> the connection the route takes
     links: dict[tuple[str, str], list[tuple[str, int]]]  # (edge, next) -> signalled links
 
     @classmethod
-    def read(cls, root: ET.Element) -> _Network:
-        edge_lane: dict[str, str] = {}
-        car_lanes: set[str] = set()
-        for edge in root.iter("edge"):
-            if edge.get("function"):
-                continue
-            for lane in edge.iter("lane"):
-                if _allows_cars(lane):
-                    car_lanes.add(lane.attrib["id"])
-                    edge_lane[edge.attrib["id"]] = lane.attrib["id"]  # the leftmost car lane
-        conns: dict[tuple[str, str], ET.Element] = {}
+    def read(cls, net: Any) -> _CarLanes:
+        edges = net.getEdges(withInternal=False)
+        edge_lane: dict[str, Any] = {}
+        for edge in edges:
+            for lane in edge.getLanes():
+                if lane.allows("passenger"):
+                    edge_lane[edge.getID()] = lane  # the last one is the leftmost car lane
+        conns: dict[tuple[str, str], Any] = {}
         links: dict[tuple[str, str], list[tuple[str, int]]] = {}
-        via_next: dict[str, str] = {}
-        for c in root.iter("connection"):
-            src, dst = c.attrib["from"], c.attrib["to"]
-            if src.startswith(":"):
-                if c.get("via"):
-                    via_next[f"{src}_{c.attrib['fromLane']}"] = c.attrib["via"]
-                continue
-            lane_from = f"{src}_{c.attrib['fromLane']}"
-            # the reference lane's connection, else the first car lane's (several lanes)
-            usable = dst in edge_lane and lane_from in car_lanes
-            if usable and (lane_from == edge_lane.get(src) or (src, dst) not in conns):
-                conns[(src, dst)] = c
-            if usable and c.get("tl") and c.get("linkIndex") is not None:
-                links.setdefault((src, dst), []).append((lane_from, int(c.attrib["linkIndex"])))
-        return cls(_lane_lengths(root), edge_lane, conns, via_next, links)
-
-
-def _allows_cars(lane: ET.Element) -> bool:
-    """Whether a lane of a normal edge carries passenger cars (not a sidewalk or bike lane)."""
-    allow, disallow = lane.get("allow"), lane.get("disallow")
-    if allow is not None:
-        return "passenger" in allow.split() or allow == "all"
-    return disallow is None or "passenger" not in disallow.split()
+        for edge in edges:
+            for to_edge, candidates in edge.getOutgoing().items():
+                key = (edge.getID(), to_edge.getID())
+                if key[1] not in edge_lane:
+                    continue
+                for conn in candidates:  # in the file's order
+                    lane = conn.getFromLane()
+                    if not lane.allows("passenger"):
+                        continue
+                    # the reference lane's connection, else the first car lane's
+                    if lane is edge_lane[key[0]] or key not in conns:
+                        conns[key] = conn
+                    if conn.getTLSID():
+                        links.setdefault(key, []).append((lane.getID(), conn.getTLLinkIndex()))
+        return cls(edge_lane, conns, links)
 
 
 @dataclass
@@ -187,64 +171,70 @@ class _Layout:
     length_m: float
 
 
-def _lay_out(net: _Network, route_edges: tuple[str, ...], net_file: Path) -> _Layout:
+def _lay_out(net: Any, road: _CarLanes, route_edges: tuple[str, ...], net_file: Path) -> _Layout:
     """Walk the route edge by edge, through the junctions' internal lanes."""
     layout = _Layout([], {}, [], [], 0.0)
     pos = 0.0
     for i, eid in enumerate(route_edges):
-        if eid not in net.edge_lane:
+        if eid not in road.edge_lane:
             raise ValueError(f"route edge {eid!r} not found in {net_file}")
-        length, speed = net.lanes[net.edge_lane[eid]]
+        lane = road.edge_lane[eid]
+        speed = lane.getSpeed()
         layout.starts.append(pos)
         if not layout.zone_limit or layout.zone_limit[-1] != speed:
             layout.zone_start.append(pos)
             layout.zone_limit.append(speed)
-        pos += length
+        pos += lane.getLength()
         layout.end[eid] = pos
         if i + 1 < len(route_edges):
-            conn = net.conns.get((eid, route_edges[i + 1]))
+            conn = road.conns.get((eid, route_edges[i + 1]))
             if conn is None:
                 raise ValueError(f"no connection {eid} -> {route_edges[i + 1]} in {net_file}")
-            via: str | None = conn.get("via")
-            nxt_speed = net.lanes[net.edge_lane[route_edges[i + 1]]][1]
+            nxt_speed = road.edge_lane[route_edges[i + 1]].getSpeed()
             if nxt_speed < speed:  # the lower limit starts at the junction
                 layout.zone_start.append(pos)
                 layout.zone_limit.append(nxt_speed)
-            while via:
-                pos += net.lanes[via][0]
-                via = net.via_next.get(via)
+            for via in _via_lanes(net, conn):
+                pos += via.getLength()
     layout.length_m = pos
     return layout
 
 
+def _via_lanes(net: Any, conn: Any) -> Iterator[Any]:
+    """The internal lanes a connection runs through its junction, in order."""
+    via_id = conn.getViaLaneID()
+    while via_id:
+        lane = net.getLane(via_id)
+        yield lane
+        onward = [c.getViaLaneID() for c in lane.getOutgoing() if c.getViaLaneID()]
+        via_id = onward[-1] if onward else ""
+
+
 def _route_crossings(
-    root: ET.Element,
-    route_edges: tuple[str, ...],
-    edge_to: dict[str, str | None],
-    nodes: dict[str, ET.Element],
-    layout: _Layout,
+    net: Any, route_edges: tuple[str, ...], layout: _Layout
 ) -> list[RouteCrossing]:
     """The pedestrian crossings over the route, ordered along it."""
+    on_route = set(route_edges)
     crossings = []
-    for edge in root.iter("edge"):
-        if edge.get("function") != "crossing":
+    for edge in net.getEdges():
+        if edge.getFunction() != "crossing":
             continue
-        crossed = set((edge.get("crossingEdges") or "").split())
-        cid = edge.attrib["id"]
-        node_id = cid[1:].rsplit("_", 1)[0]
-        route_in = [e for e in route_edges[:-1] if edge_to[e] == node_id]
-        if not crossed & set(route_edges) or not route_in:
+        node = edge.getFromNode()  # the crossing's junction
+        route_in = [
+            e for e in route_edges[:-1] if net.getEdge(e).getToNode().getID() == node.getID()
+        ]
+        crossed = {e.getID() for e in edge.getCrossingEdges()}
+        if not crossed & on_route or not route_in:
             continue
         walk = sorted(
-            {c.attrib["from"] for c in root.iter("connection") if c.attrib["to"] == cid}
-            | {c.attrib["to"] for c in root.iter("connection") if c.attrib["from"] == cid}
+            {e.getID() for e in edge.getIncoming()} | {e.getID() for e in edge.getOutgoing()}
         )
         crossings.append(
             RouteCrossing(
-                crossing_edge=cid,
+                crossing_edge=edge.getID(),
                 walkingareas=tuple(walk),
                 stop_line_m=layout.end[route_in[0]],
-                signalized=nodes[node_id].get("type") == "traffic_light",
+                signalized=node.getType() == "traffic_light",
                 end_m=layout.starts[route_edges.index(route_in[0]) + 1],
                 approach_edge=route_in[0],
             )

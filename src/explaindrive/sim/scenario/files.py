@@ -3,13 +3,16 @@
 A scenario is the paper's road, a road of the family (:mod:`explaindrive.sim.scenario.params`)
 or a network of your own with a route through it (:mod:`explaindrive.sim.network`). The
 first two carry their flows and pedestrians in a :class:`~explaindrive.sim.scenario.layout.
-Layout`; an own network brings its background demand as route files.
+Layout`; an own network brings its background demand as route files, or has trips generated
+over it for each traffic level (:func:`generated_trips`).
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+import subprocess
+import sys
 import tempfile
 from dataclasses import dataclass
 from importlib import resources
@@ -18,6 +21,7 @@ from xml.sax.saxutils import quoteattr
 
 from explaindrive.cache import cache_dir as user_cache_dir
 from explaindrive.sim.scenario import layout
+from explaindrive.sim.sumo_home import sumo_home
 
 EGO_ROUTE_ID = "ego_route"
 EGO_TYPE_ID = "ego_type"
@@ -25,6 +29,14 @@ EGO_ID = "ego"
 # vTypes of the ego when SUMO drives it (baselines): same size and limits as the agent's ego.
 BASELINE_EGO_TYPES: dict[str, str] = {"krauss": "ego_krauss", "idm": "ego_idm"}
 FLOW_END_S = 4_000  # [s] flows outlast warm-up plus the longest episode
+TRIPS_PER_HOUR_PER_KM = 60.0
+"""[veh/h per km of lane] generated background trips at traffic level 1.0."""
+TRIPS_SEED = 42
+"""Seed of the generated trips (the episode seed varies the simulation itself)."""
+
+
+class NetworkError(ValueError):
+    """A network, route or demand file that cannot be used; the message names why."""
 
 
 def package_data_dir() -> Path:
@@ -87,6 +99,41 @@ def routes_xml(
     return "\n".join(lines) + "\n"
 
 
+def generated_trips(net_file: Path, cache_dir: Path, traffic_level: float = 1.0) -> Path:
+    """Background trips over the whole network at a traffic level, made once per network and
+    level with ``randomTrips.py`` and cached.
+
+    Raises:
+        NetworkError: if randomTrips fails (e.g. no two edges are connected).
+    """
+    digest = hashlib.sha1(net_file.read_bytes()).hexdigest()[:10]
+    density = TRIPS_PER_HOUR_PER_KM * traffic_level  # [veh/h per km of lane]
+    path = cache_dir / "trips" / f"{digest}_{density:g}.rou.xml"
+    if path.exists():
+        return path
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=path.parent))
+    script = sumo_home() / "tools" / "randomTrips.py"
+    args = [
+        sys.executable, str(script), "-n", str(net_file.resolve()), "-o", str(tmp / "trips.xml"),
+        "-r", str(tmp / "routes.rou.xml"), "--begin", "0", "--end", str(FLOW_END_S),
+        "--insertion-density", f"{density:g}", "--seed", str(TRIPS_SEED),
+        "--vehicle-class", "passenger", "--fringe-factor", "5", "--min-distance", "100",
+        "--prefix", "bg", "--validate",
+        "--trip-attributes", 'departLane="best" departSpeed="max"',
+    ]  # fmt: skip
+    proc = subprocess.run(args, capture_output=True, text=True, check=False, cwd=tmp)
+    routes = tmp / "routes.rou.xml"
+    if proc.returncode != 0 or not routes.is_file():
+        detail = (proc.stderr or proc.stdout).strip().splitlines()[-1:] or ["no output"]
+        raise NetworkError(f"randomTrips.py could not make trips for {net_file}: {detail[0]}")
+    os.replace(routes, path)
+    for leftover in tmp.iterdir():
+        leftover.unlink()
+    tmp.rmdir()
+    return path
+
+
 @dataclass(frozen=True, slots=True)
 class ScenarioFiles:
     """A scenario: its network, the ego's route, its demand, and where generated files go.
@@ -100,7 +147,7 @@ class ScenarioFiles:
         demand_files: background demand of an own network; SUMO scales it by the traffic
             level (``--scale``).
         trips: whether an own network's demand is trips generated over it at the traffic
-            level (:func:`explaindrive.sim.network.generated_trips`).
+            level (:func:`generated_trips`).
         begin_s: simulation time at which the demand starts [s]; the warm-up runs from it.
         name: how tables and logs name the scenario.
     """
@@ -128,8 +175,6 @@ class ScenarioFiles:
     def routes_files(self, traffic_level: float) -> tuple[Path, ...]:
         """The route files SUMO loads at a traffic level: the generated one first."""
         if self.trips:
-            from explaindrive.sim.network import generated_trips
-
             return (self.routes_file(traffic_level),
                     generated_trips(self.net_file, self.cache_dir, traffic_level))  # fmt: skip
         return (self.routes_file(traffic_level), *self.demand_files)

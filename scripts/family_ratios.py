@@ -1,0 +1,99 @@
+"""The scenario family's figures beside the paper's road, from ``scripts/evaluate_family.sh``.
+
+    python scripts/family_ratios.py [out/family]
+
+For each driver and each of its runs on the family (generated scenarios, the netgenerate
+grid; with and without stops), every ride figure and violation count next to the same
+driver's on the paper's road on the same seeds and levels, with their ratio; and each
+network's mean speed as a share of Krauss's on the same episodes.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+FIGURES = (
+    ("mean speed m/s", "mean_speed_mps"),
+    ("free-road speed (of the limit)", "free_road_speed_share"),
+    ("free road < 60 %", "slow_free_road_share"),
+    ("hard brakes /episode", "hard_brakes_per_episode"),
+    ("reversals /min following", "reversals_per_min"),
+    ("avg jerk m/s^3", "avg_jerk_mps3"),
+    ("standstill before a light m", "light_stop_gap_mean_m"),
+    ("standstill before a crossing m", "crossing_stop_gap_mean_m"),
+)
+COUNTS = ("collision_episodes", "red_light_runs", "ped_violations", "speeding_steps",
+          "stop_bound_misses")  # fmt: skip
+VARIANTS = ("family_{p}", "family_{p}_stops", "grid_{p}", "grid_{p}_stops")
+
+
+def overall(folder: Path, name: str) -> dict[str, Any] | None:
+    """The overall aggregates of run ``name``, or ``None`` if it was not run."""
+    path = folder / f"{name}.json"
+    if not path.is_file():
+        return None
+    return json.loads(path.read_text(encoding="utf-8"))["runs"][0]["aggregates"]["overall"]
+
+
+def _fmt(value: float | None) -> str:
+    return "–" if value is None else f"{value:.3f}"
+
+
+def _ratio(value: float | None, reference: float | None) -> str:
+    if value is None or reference is None or reference == 0:
+        return "–"
+    return f"{value / reference:.2f}"
+
+
+def table(folder: Path, driver: str) -> list[str]:
+    """Markdown lines comparing ``driver``'s family runs with its paper-road run."""
+    road = overall(folder, f"road_{driver}")
+    runs = [(v.format(p=driver), overall(folder, v.format(p=driver))) for v in VARIANTS]
+    runs = [(name, a) for name, a in runs if a is not None]
+    if road is None or not runs:
+        return []
+    head = ["figure", f"road_{driver}"] + [f"{name} (ratio)" for name, _ in runs]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for label, key in FIGURES:
+        cells = [f"{_fmt(a[key])} ({_ratio(a[key], road[key])})" for _, a in runs]
+        lines.append("| " + " | ".join([label, _fmt(road[key]), *cells]) + " |")
+    for key in COUNTS:
+        cells = [str(a.get(key, "–")) for _, a in runs]
+        lines.append("| " + " | ".join([key, str(road.get(key, "–")), *cells]) + " |")
+    lines.append("| episodes | " + " | ".join(
+        [str(road["episodes"])] + [str(a["episodes"]) for _, a in runs]) + " |")  # fmt: skip
+    return lines
+
+
+def krauss_shares(folder: Path) -> list[str]:
+    """Each network's mean speed as a share of Krauss's on the same episodes."""
+    lines = []
+    for where in ("road", "family", "grid"):
+        krauss = overall(folder, f"{where}_krauss")
+        for driver in ("fast", "comfort"):
+            a = overall(folder, f"{where}_{driver}")
+            if krauss and a:
+                share = a["mean_speed_mps"] / krauss["mean_speed_mps"]
+                speeds = f"{a['mean_speed_mps']:.3f} m/s, Krauss {krauss['mean_speed_mps']:.3f} m/s"
+                lines.append(f"- {where}: {driver} {speeds}: {100 * share:.1f} %")
+    return lines
+
+
+def main(folder: Path) -> None:
+    """Print the tables of every driver found in ``folder``."""
+    for driver in ("fast", "comfort", "krauss"):
+        lines = table(folder, driver)
+        if lines:
+            print(f"\n### {driver}\n")
+            print("\n".join(lines))
+    shares = krauss_shares(folder)
+    if shares:
+        print("\n### Mean speed against Krauss\n")
+        print("\n".join(shares))
+
+
+if __name__ == "__main__":
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("out/family"))
