@@ -70,7 +70,10 @@ def test_smollm2_through_the_openai_backend(smollm2: LanguageStack) -> None:
     for text, never in REQUESTS:
         r = smollm2.interpreter.interpret(text)
         assert r.confirmation in TEMPLATES, (text, r)
-        assert r.intent is not never or never is None, (text, r)
+        if never is not None and r.intent is never:
+            # the written policy: a remote STOP on an unsure embedded reading is asked back
+            assert (never, r.rule) == (Command.STOP, "stop-remote"), (text, r)
+            assert r.confirmation == format_confirmation(Command.STOP), (text, r)
         if text.startswith("Stop the car"):
             assert (r.intent, r.stop_lane, r.raw_reply) == (Command.STOP, True, None)
         key = "fallback" if r.fallback else "vetoed" if r.overruled else "accepted"
