@@ -11,16 +11,18 @@ environment judges violations and computes rewards on the true state.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
-from numpy.typing import NDArray
 from pydantic import AfterValidator
 
 from explaindrive.config import FROM_LIST
-from explaindrive.env import state as S
 
-DISTANCE_INDICES = (S.D_LEAD, S.D_TL, S.D_CROSS)
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+
+# numpy and the state module load when noise is applied, not with the configs that only
+# check a noise field (``ride --help`` reads RideConfig)
 MAX_NOISE_SD_M = 20.0  # [m] largest accepted standard deviation on distances
 MAX_NOISE_SD_MPS = 5.0  # [m/s] largest accepted standard deviation on speeds
 
@@ -47,11 +49,15 @@ class ObservationNoise:
 
     def apply(self, obs: NDArray[np.float32], rng: np.random.Generator) -> NDArray[np.float32]:
         """A noisy copy of a raw observation (``obs`` is left as it is)."""
+        import numpy as np
+
+        from explaindrive.env import state as S
+
         out = obs.astype(np.float32, copy=True)
         if not self.active:
             return out
         draws = rng.standard_normal(5)
-        for k, i in enumerate(DISTANCE_INDICES):
+        for k, i in enumerate((S.D_LEAD, S.D_TL, S.D_CROSS)):
             if out[i] < S.SENSOR_RANGE_M:
                 out[i] = out[i] + self.sd_m * draws[k]
         out[S.V_EGO] = out[S.V_EGO] + self.sd_mps * draws[3]
