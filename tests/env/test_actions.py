@@ -7,6 +7,7 @@ from explaindrive.env.actions import (
     braking_distance,
     braking_distances,
     can_stop_before,
+    least_stopping_need,
     stopping_need,
 )
 
@@ -37,6 +38,18 @@ def test_braking_distances_of_a_batch_match_the_step_sum() -> None:
 )
 def test_stopping_need(v_new: float, expected: float) -> None:
     assert stopping_need(v_new) == pytest.approx(expected)
+
+
+@pytest.mark.parametrize(
+    ("v", "expected"),
+    [
+        (3.0, 0.0),  # braking hardest stands still at once
+        (11.0, 8.0 + 7.0 + 2.0),  # the step to 8 m/s, then as stopping_need(8)
+        (12.0, 9.0 + 9.0 + 2.0),  # to 9 m/s
+    ],
+)
+def test_least_stopping_need(v: float, expected: float) -> None:
+    assert least_stopping_need(v) == pytest.approx(expected)
 
 
 @pytest.mark.parametrize(

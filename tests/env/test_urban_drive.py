@@ -8,7 +8,7 @@ from gymnasium.utils.env_checker import check_env
 
 import explaindrive
 from explaindrive.env import state as S
-from explaindrive.env.actions import MAX_BRAKE_MPS, action_index, stopping_need
+from explaindrive.env.actions import action_index, least_stopping_need
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.metrics import EpisodeMetrics
 from explaindrive.env.ride_quality import is_free_road
@@ -310,7 +310,7 @@ def test_a_pedestrian_reaching_the_kerb_waits_for_a_car_that_cannot_stop(make_en
     while True:
         obs, _, terminated, truncated, _ = env.step(driver(obs))
         ep = env._episode()
-        reach = stopping_need(max(ep.speed_mps - MAX_BRAKE_MPS, 0.0))
+        reach = least_stopping_need(ep.speed_mps)
         if 0.0 < zebra.stop_line_m - ep.pos_m < reach:
             at_kerb = [p for wa in zebra.walkingareas for p in api.edge.getLastStepPersonIDs(wa)
                        if api.person.getNextEdge(p) == zebra.crossing_edge]  # fmt: skip

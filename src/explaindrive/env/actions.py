@@ -76,13 +76,24 @@ def stopping_need(v_new: float) -> float:
     return float(stopping_needs(np.asarray(v_new)))
 
 
+def least_stopping_needs(speed_mps: NDArray[np.floating]) -> NDArray[np.float64]:
+    """[m] cars at ``speed_mps`` need ahead of their front to stand still, braking hardest
+    from now on: :func:`stopping_needs` after a hardest-braking step."""
+    v = np.asarray(speed_mps, dtype=np.float64)
+    return stopping_needs(np.maximum(v - MAX_BRAKE_MPS, 0.0))
+
+
+def least_stopping_need(speed_mps: float) -> float:
+    """:func:`least_stopping_needs` of one speed."""
+    return float(least_stopping_needs(np.asarray(speed_mps)))
+
+
 def stops_before(
     speed_mps: NDArray[np.floating], distance_m: NDArray[np.floating]
 ) -> NDArray[np.bool_]:
     """Whether cars at ``speed_mps`` can still stand :data:`STOP_MARGIN_M` before lines
     ``distance_m`` ahead by braking hardest from now on (outside a yellow's dilemma zone)."""
-    v = np.asarray(speed_mps, dtype=np.float64)
-    return stopping_needs(np.maximum(v - MAX_BRAKE_MPS, 0.0)) <= np.asarray(distance_m)
+    return least_stopping_needs(speed_mps) <= np.asarray(distance_m)
 
 
 def can_stop_before(speed_mps: float, distance_m: float) -> bool:

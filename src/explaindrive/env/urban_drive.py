@@ -24,9 +24,9 @@ from explaindrive.cache import cache_dir as user_cache_dir
 from explaindrive.commands import Command
 from explaindrive.env import state as S
 from explaindrive.env.actions import (
-    MAX_BRAKE_MPS,
     N_ACTIONS,
     STEP_LENGTH_S,
+    least_stopping_need,
     speed_change,
     stopping_need,
 )
@@ -320,7 +320,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         they are seen as stepping out (it ran before the step, when they were not yet there).
         """
         ep = self._episode()
-        reach = stopping_need(max(ep.speed_mps - MAX_BRAKE_MPS, 0.0))
+        reach = least_stopping_need(ep.speed_mps)
         ep.kerb.update(self._sumo.api, self.geometry.crossings, ep.pos_m, self._ego_length_m, reach)
         return ep.perception(self._sumo.api, ego, ep.pos_m, ep.command, ep.amber, ep.kerb)
 
