@@ -15,8 +15,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import sumolib
 from sumolib import geomhelper
+
+from explaindrive.sim.route import read_net
 
 BODY_HALF_WIDTH_M = 0.5  # [m] a pedestrian this close to the lane's edge is in it
 ENTERING_HORIZON_S = 1.0  # [s] a pedestrian who reaches the lane within this is entering it
@@ -70,7 +71,7 @@ def crossing_lanes(net_file: str | Path, crossings: dict[str, str]) -> dict[str,
         ValueError: if a crossing or edge is not in the network, or the edge has no lane
             for cars.
     """
-    net = sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
+    net = read_net(net_file)
     out: dict[str, CrossingLane] = {}
     for crossing_edge, edge_id in crossings.items():
         try:

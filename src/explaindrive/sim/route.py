@@ -93,13 +93,20 @@ class RouteGeometry:
         return limit
 
 
+def read_net(net_file: str | Path) -> Any:
+    """The network as sumolib reads it, with internal lanes and pedestrian connections: the
+    one way the route, the crossing lanes, the scene and the plots read a network (sumolib's
+    objects are untyped, hence ``Any``)."""
+    return sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
+
+
 def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGeometry:
     """Read the ego route's geometry from a network file.
 
     Raises:
         ValueError: if the route is not drivable in the network.
     """
-    net = sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
+    net = read_net(net_file)
     road = _CarLanes.read(net)
     layout = _lay_out(net, road, route_edges, net_file)
     lights = [

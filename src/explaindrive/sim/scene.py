@@ -14,8 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import sumolib
-
+from explaindrive.sim.route import read_net
 from explaindrive.sim.scenario.files import EGO_ID
 
 VIEW_RADIUS_M = 150.0  # [m] objects farther from the ego are not streamed
@@ -93,7 +92,7 @@ def load_scene(net_file: Path) -> Scene:
     """
     if not net_file.is_file():
         raise FileNotFoundError(f"SUMO network file not found: {net_file}")
-    net = sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
+    net = read_net(net_file)
     lanes: list[dict[str, Any]] = []
     crossings: list[dict[str, Any]] = []
     for edge in net.getEdges(withInternal=True):

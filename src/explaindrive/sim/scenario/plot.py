@@ -8,14 +8,14 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-import sumolib
 
+from explaindrive.sim.route import read_net
 from explaindrive.sim.scenario.layout import EGO_ROUTE_EDGES, KMH
 
 
 def plot_network(net_file: Path, out_file: Path) -> Path:
     """Render lanes (ego route by speed zone), lights, crossings and sidewalks to a PNG."""
-    net = sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
+    net = read_net(net_file)
     fig, ax = plt.subplots(figsize=(14, 4.2))
     zone_colour = {50: "#1f77b4", 30: "#ff7f0e"}
     for edge in net.getEdges(withInternal=True):
