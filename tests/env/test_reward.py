@@ -135,23 +135,26 @@ def test_hard_brake_penalty_charges_braking_beyond_one_mps2():
 
 def test_passenger_fast_terms():
     # braking at -3 m/s per step while closing in on a stop line (a virtual leader)
-    f = _features(speed_change_mps=-3, accel_mps2=-3.0, leader_gap_m=10.0, closing_speed_mps=10.0)
+    f = _features(
+        speed_change_mps=-3, accel_mps2=-3.0, leader_gap_m=10.0, closing_speed_mps=10.0,
+        leader_virtual=True,
+    )  # fmt: skip
     t = R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE)
     assert t.ttc == pytest.approx(2 * -0.693147, abs=1e-6)
     assert t.headway == 0.0  # no real leader: a stop line earns no headway reward
     assert t.jerk == pytest.approx(-0.3 * 4)
     assert t.speed == pytest.approx(3 * 10 / 13.89)
-    assert t.time == -0.5
-    assert t.brake == -4.0  # 1.0 * (3 - 1)^2
-    # the room keeps 1 s at 10 m/s: 10 - 2 - 10 < 0.5 m, floored at 0.5 m; stopping 10 m/s
-    # in it needs 100 / 1 = 100 m/s^2, capped at 9: 0.3 * 7.5^2 = 16.875
-    assert t.approach == pytest.approx(-16.875)
+    assert t.time == -0.75
+    assert t.brake == -8.0  # 2.0 * (3 - 1)^2
+    # before a stop line the room keeps no time gap: 10 - 2 = 8 m; stopping 10 m/s in it
+    # needs 100 / 16 = 6.25 m/s^2: 0.3 * 4.75^2 = 6.76875
+    assert t.approach == pytest.approx(-6.76875)
     assert t.cruise == 0.0  # not a free road
-    # -1.386294 - 1.2 + 2.159827 - 0.5 - 4.0 - 16.875 = -21.801467
-    assert t.total == pytest.approx(-21.801467, abs=1e-5)
+    # -1.386294 - 1.2 + 2.159827 - 0.75 - 8.0 - 6.76875 = -15.945217
+    assert t.total == pytest.approx(-15.945217, abs=1e-5)
 
 
-def test_passenger_approach_keeps_a_time_gap():
+def test_passenger_approach_keeps_a_time_gap_behind_vehicles_only():
     # 8 m/s towards a standing queue 40 m ahead: the room is 40 - 2 - 8 = 30 m
     f = _features(speed_mps=8.0, leader_gap_m=40.0, closing_speed_mps=8.0)
     t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
@@ -161,7 +164,10 @@ def test_passenger_approach_keeps_a_time_gap():
     t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
     # room 40 - 2 - 12 = 26 m; 144 / 52 = 2.769231 m/s^2; 1.0 * 1.269231^2 = 1.610947
     assert t.approach == pytest.approx(-1.610947, abs=1e-6)
-    # without the time gap: 144 / 76 = 1.894737 m/s^2; 0.394737^2 = 0.155817
+    # a stop line 40 m ahead keeps no time gap: 144 / 76 = 1.894737 m/s^2; 0.394737^2
+    f = _features(speed_mps=12.0, leader_gap_m=40.0, closing_speed_mps=12.0, leader_virtual=True)
+    t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
+    assert t.approach == pytest.approx(-0.155817, abs=1e-6)
     assert R.approach_penalty(40.0, 12.0, 1.0) == pytest.approx(-0.155817, abs=1e-6)
 
 

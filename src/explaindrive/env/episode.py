@@ -129,6 +129,7 @@ class StepRecord:
             real_headway_s=time_headway(real.gap_m, real.length_m, v) if real else math.inf,
             accel_mps2=self.accel,
             leader_gap_m=leader.gap_m if leader else math.inf,
+            leader_virtual=leader.virtual if leader else False,
             closing_speed_mps=v - leader.speed_mps if leader else 0.0,
             free_road=self.free_road,
         )

@@ -17,9 +17,11 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
   (``hard_brake``), more under comfort;
 * closing in on a leader, a red light or a pedestrian too fast to stop gently is charged
   (``approach``): the deceleration that would just stop in time, as IDM's braking
-  strategy has it, beyond a comfortable 1.5 m/s^2, so the car slows down early; the
-  room to stop in keeps a time gap of ``approach_time_gap_s`` at the car's speed, as IDM's
-  desired gap does, so that the car eases off before a queue rather than at its tail;
+  strategy has it, beyond a comfortable 1.5 m/s^2, so the car slows down early; behind a
+  vehicle the room to stop in keeps a time gap of ``approach_time_gap_s`` at the car's
+  speed, as IDM's desired gap does, so that the car eases off before a queue rather than at
+  its tail; before a stop line it keeps only the standstill gap, so that a light turning
+  yellow ahead calls for the gentlest deceleration that stops at the line, not a harder one;
 * driving below 90 % of the limit on a free road is charged (``cruise``): on an open road a
   passenger expects the car to go;
 * comfort's progress is worth as much as fast's: the two differ in smoothness.
@@ -69,7 +71,8 @@ class RewardWeights:
         approach: weight of -(needed deceleration beyond :data:`COMFORT_DECEL_MPS2`)^2
             (:func:`approach_penalty`).
         approach_time_gap_s: the time gap [s] at the car's speed that the approach keeps
-            clear of the obstacle besides :data:`APPROACH_STANDSTILL_M`.
+            clear of a vehicle ahead besides :data:`APPROACH_STANDSTILL_M` (not of a stop
+            line).
         cruise: weight of -(:data:`CRUISE_SHARE` - v / v_lim) on a free road below it.
         signal_stop: paid per step standing for a light or a pedestrian.
         stop_window_m: ``(min, max)`` distance to the line within which ``signal_stop`` is
@@ -123,9 +126,9 @@ PASSENGER_RECIPE = RewardRecipe(
         *FAST_CF_WEIGHTS,
         headway_on_stop_lines=False,
         speed=FAST_SPEED_WEIGHT,
-        time=0.5,
+        time=0.75,
         jerk=0.3,
-        hard_brake=1.0,
+        hard_brake=2.0,
         approach=0.3,
         approach_time_gap_s=1.0,
         cruise=3.0,
@@ -138,7 +141,7 @@ PASSENGER_RECIPE = RewardRecipe(
         speed=FAST_SPEED_WEIGHT,
         time=0.5,
         jerk=1.0,
-        hard_brake=2.0,
+        hard_brake=3.0,
         approach=1.0,
         approach_time_gap_s=1.0,
         cruise=5.0,
@@ -282,6 +285,7 @@ class StepFeatures:
     real_headway_s: float = math.inf  # w.r.t. the real leader (inf without one)
     accel_mps2: float | None = None  # the step's speed change as driven; None: the action's
     leader_gap_m: float = math.inf  # gap to the effective leader after the step [m]
+    leader_virtual: bool = False  # the effective leader is a stop line (light or crossing)
     closing_speed_mps: float = 0.0  # ego speed minus the effective leader's, after the step
     free_road: bool = False  # as the ride-quality figures define it (env/ride_quality.py)
 
@@ -344,7 +348,10 @@ def reward_terms(
         time=-w.time,
         brake=hard_brake_penalty(accel, w.hard_brake),
         approach=approach_penalty(
-            f.leader_gap_m, f.closing_speed_mps, w.approach, w.approach_time_gap_s * f.speed_mps
+            f.leader_gap_m,
+            f.closing_speed_mps,
+            w.approach,
+            0.0 if f.leader_virtual else w.approach_time_gap_s * f.speed_mps,
         ),
         cruise=cruise_penalty(f.speed_mps, f.limit_mps, f.free_road, w.cruise),
     )
