@@ -392,3 +392,18 @@ def test_the_cruise_term_charges_exactly_the_slow_free_road_steps(make_env):
         if terminated or truncated:
             break
     assert charged == slow_free > 0  # the start from standstill is slow on a free road
+
+
+def test_the_env_reads_its_network_once(monkeypatch):
+    import explaindrive.env.urban_drive as urban_drive
+
+    calls = []
+    real = urban_drive.read_net
+    monkeypatch.setattr(urban_drive, "read_net", lambda f: calls.append(f) or real(f))
+    env = urban_drive.UrbanDriveEnv()
+    try:
+        assert len(calls) == 1
+        assert env.geometry.crossings  # the route geometry and the crossing lanes from it
+        assert set(env._crossing_lanes) == {c.crossing_edge for c in env.geometry.crossings}
+    finally:
+        env.close()

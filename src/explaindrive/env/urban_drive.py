@@ -43,7 +43,7 @@ from explaindrive.env.sumo_process import SUMO_DRIVES, EgoEntry, Motion, SumoPro
 from explaindrive.env.violations import ViolationJudge
 from explaindrive.sim.crossing_lanes import CrossingLane, crossing_lanes
 from explaindrive.sim.pedestrians import PedestrianSource
-from explaindrive.sim.route import RouteGeometry, load_route_geometry
+from explaindrive.sim.route import RouteGeometry, load_route_geometry, read_net
 from explaindrive.sim.scenario.files import ScenarioFiles
 from explaindrive.sim.scenario.limits import SATURATED_LEVEL, SEED_LIMIT, validate_seed
 from explaindrive.sim.scenario.source import ScenarioSource
@@ -346,9 +346,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def _load_geometry(self, scenario: ScenarioFiles) -> None:
         """The route's geometry and the ego lane's stretch on each of its crossings."""
-        self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges)
+        net = read_net(scenario.net_file)
+        self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges, net)
         self._crossing_lanes = crossing_lanes(
-            scenario.net_file, {c.crossing_edge: c.approach_edge for c in self.geometry.crossings}
+            scenario.net_file,
+            {c.crossing_edge: c.approach_edge for c in self.geometry.crossings},
+            net,
         )
 
     def _use_scenario(self, scenario: ScenarioFiles) -> None:

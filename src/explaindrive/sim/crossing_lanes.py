@@ -59,19 +59,23 @@ class CrossingLane:
         return heading < 0 and offset_m - reach <= hi
 
 
-def crossing_lanes(net_file: str | Path, crossings: dict[str, str]) -> dict[str, CrossingLane]:
+def crossing_lanes(
+    net_file: str | Path, crossings: dict[str, str], net: Any | None = None
+) -> dict[str, CrossingLane]:
     """The ego lane's stretch along each crossing.
 
     Args:
         net_file: the SUMO network.
         crossings: crossing edge id -> the route edge that approaches it (the ego drives on
             its first lane that allows passenger cars).
+        net: ``net_file`` as :func:`~explaindrive.sim.route.read_net` read it, if the
+            caller already has it.
 
     Raises:
         ValueError: if a crossing or edge is not in the network, or the edge has no lane
             for cars.
     """
-    net = read_net(net_file)
+    net = read_net(net_file) if net is None else net
     out: dict[str, CrossingLane] = {}
     for crossing_edge, edge_id in crossings.items():
         try:

@@ -100,13 +100,20 @@ def read_net(net_file: str | Path) -> Any:
     return sumolib.net.readNet(str(net_file), withInternal=True, withPedestrianConnections=True)
 
 
-def load_route_geometry(net_file: Path, route_edges: tuple[str, ...]) -> RouteGeometry:
+def load_route_geometry(
+    net_file: Path, route_edges: tuple[str, ...], net: Any | None = None
+) -> RouteGeometry:
     """Read the ego route's geometry from a network file.
+
+    Args:
+        net_file: the SUMO network.
+        route_edges: the ego's route.
+        net: ``net_file`` as :func:`read_net` read it, if the caller already has it.
 
     Raises:
         ValueError: if the route is not drivable in the network.
     """
-    net = read_net(net_file)
+    net = read_net(net_file) if net is None else net
     road = _CarLanes.read(net)
     layout = _lay_out(net, road, route_edges, net_file)
     lights = [
