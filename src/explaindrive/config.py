@@ -17,13 +17,13 @@ the scenario's one definition of its range (:mod:`explaindrive.sim.scenario.limi
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Any, ClassVar, Self
 
-import yaml
 from pydantic import (
     AfterValidator,
     BaseModel,
@@ -167,15 +167,21 @@ def one_of(choices: tuple[str, ...]) -> AfterValidator:
     return AfterValidator(check)
 
 
-class _Loader(yaml.SafeLoader):
-    """YAML as PyYAML reads it, except that ``1e-3`` (an exponent, no dot) is a number."""
+@functools.cache
+def _loader() -> type:
+    """YAML as PyYAML reads it, except that ``1e-3`` (an exponent, no dot) is a number (built
+    on first use: a command's ``--help`` does not import PyYAML)."""
+    import yaml
 
+    class Loader(yaml.SafeLoader):
+        pass
 
-_Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
-    list("-+0123456789."),
-)
+    Loader.add_implicit_resolver(
+        "tag:yaml.org,2002:float",
+        re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+        list("-+0123456789."),
+    )
+    return Loader
 
 
 def read_yaml(text: str) -> Any:
@@ -184,4 +190,6 @@ def read_yaml(text: str) -> Any:
     Raises:
         yaml.YAMLError: if the text is not valid YAML.
     """
-    return yaml.load(text, Loader=_Loader)  # _Loader is a SafeLoader
+    import yaml
+
+    return yaml.load(text, Loader=_loader())  # a SafeLoader

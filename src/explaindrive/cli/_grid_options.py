@@ -10,13 +10,14 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from explaindrive.cli._errors import print_error
 from explaindrive.limits import MAX_STEPS, MAX_WORKERS
 from explaindrive.sim.scenario.limits import TRAFFIC_LEVELS
 
 if TYPE_CHECKING:
+    from rich.progress import Progress
+
     from explaindrive.evaluation.runner import Progress as EpisodeProgress
 
 err_console = Console(stderr=True, soft_wrap=True)  # an error line never wraps
@@ -83,6 +84,8 @@ def check_ray_target(ray: bool, ray_address: str | None) -> str | None:
 
 def progress_bar() -> Progress:
     """The episode progress bar (on stderr, so stdout keeps only the tables)."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
     return Progress(
         TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
         TimeElapsedColumn(), console=err_console, transient=True,
