@@ -86,7 +86,7 @@ def test_safe_learning_pushes_unsafe_actions_down_and_masks_the_target() -> None
     q = learner.q_values(obs[:1])[0]
     assert q[5] < -4.5 and q[6] < -4.5  # pushed down to the floor (or below: one-sided)
     assert q[3] == pytest.approx(1.0, abs=0.1)  # the taken action's terminal reward
-    assert stats["unsafe_loss"] < 0.1
+    assert stats.unsafe_loss < 0.1
 
 
 def test_epsilon_drops_to_its_final_value() -> None:
@@ -112,7 +112,7 @@ def test_learner_learns_a_contextual_bandit() -> None:
     obs = rng.uniform(0, 1, (2000, 8)).astype(np.float32) * np.float32(20)
     actions = rng.integers(0, 7, 2000)
     buf.add(obs, actions, (actions == 6).astype(np.float32), obs, np.ones(2000, bool), 0.99)
-    losses = [learner.update(buf.sample(64, rng), 0)["td_loss"] for _ in range(300)]
+    losses = [learner.update(buf.sample(64, rng), 0).td_loss for _ in range(300)]
     assert np.mean(losses[-20:]) < 0.1 * np.mean(losses[:20])
     assert (learner.act(obs[:100], 0.0, rng) == 6).all()
     assert learner.updates == 300

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -18,6 +19,20 @@ from explaindrive.agent.targets import (
     unsafe_action_loss,
 )
 from explaindrive.env.actions import N_ACTIONS
+
+
+@dataclass(frozen=True, slots=True)
+class UpdateStats:
+    """What one gradient step did (the run log's TensorBoard scalars)."""
+
+    td_loss: float
+    unsafe_loss: float
+    """0 without ``safe_learning``."""
+    q_values: float
+    """Mean Q of the taken actions."""
+    learning_rate: float
+    grad_norm: float
+    """Before clipping; 0 when clipping is off."""
 
 
 class D3QNLearner:
@@ -87,16 +102,11 @@ class D3QNLearner:
         """Epsilon-greedy actions for a batch of raw observations, in one forward pass."""
         return self.explore(self.q_values(obs), epsilon, rng, mask)
 
-    def update(self, batch: ReplayBatch, env_steps: int) -> dict[str, float]:
+    def update(self, batch: ReplayBatch, env_steps: int) -> UpdateStats:
         """One gradient step on a minibatch; updates the target network when due.
 
         With ``safe_learning`` the double-DQN argmax runs over the safe actions of the next
         state and the unsafe actions of the state are pushed down to ``unsafe_q``.
-
-        Returns:
-            ``td_loss``, ``unsafe_loss`` (0 without ``safe_learning``), ``q_values`` (mean Q
-            of the taken actions), ``learning_rate`` and ``grad_norm`` (before clipping; 0
-            when clipping is off).
         """
         c = self.config
         lr = self.learning_rate(env_steps)
@@ -136,13 +146,13 @@ class D3QNLearner:
         self.updates += 1
         if self.updates % c.target_update_interval == 0:
             self.update_target(c.tau)
-        return {
-            "td_loss": float(td.detach()),
-            "unsafe_loss": float(unsafe.detach()),
-            "q_values": float(q_taken.detach().mean()),
-            "learning_rate": lr,
-            "grad_norm": grad_norm,
-        }
+        return UpdateStats(
+            td_loss=float(td.detach()),
+            unsafe_loss=float(unsafe.detach()),
+            q_values=float(q_taken.detach().mean()),
+            learning_rate=lr,
+            grad_norm=grad_norm,
+        )
 
     @torch.no_grad()
     def update_target(self, tau: float) -> None:

@@ -10,13 +10,16 @@ import logging
 import subprocess
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.rollout import EpisodeSummary
 from explaindrive.extras import install_line
+
+if TYPE_CHECKING:
+    from explaindrive.agent.learner import UpdateStats
 
 log = logging.getLogger(__name__)
 
@@ -226,16 +229,16 @@ class RunLog:
         tb_episode(self.tb, ep, env_steps, epsilon, steps_per_s)
         self._progress.update(episodes_done, ep.ret, mean_return, epsilon, steps_per_s)
 
-    def losses(self, stats: dict[str, float], step: int) -> None:
-        """The TensorBoard scalars of a learner update (its ``stats``) at env step ``step``."""
+    def losses(self, stats: UpdateStats, step: int) -> None:
+        """The TensorBoard scalars of a learner update at env step ``step``."""
         c = self.config
-        self.tb.add_scalar("losses/td_loss", stats["td_loss"], step)
-        self.tb.add_scalar("losses/q_values", stats["q_values"], step)
-        self.tb.add_scalar("charts/learning_rate", stats["learning_rate"], step)
+        self.tb.add_scalar("losses/td_loss", stats.td_loss, step)
+        self.tb.add_scalar("losses/q_values", stats.q_values, step)
+        self.tb.add_scalar("charts/learning_rate", stats.learning_rate, step)
         if c.safe_learning:
-            self.tb.add_scalar("losses/unsafe_loss", stats["unsafe_loss"], step)
+            self.tb.add_scalar("losses/unsafe_loss", stats.unsafe_loss, step)
         if c.grad_clip_norm is not None:
-            self.tb.add_scalar("losses/grad_norm", stats["grad_norm"], step)
+            self.tb.add_scalar("losses/grad_norm", stats.grad_norm, step)
 
     def flush(self) -> None:
         """Write the CSV rows so far to disk."""
