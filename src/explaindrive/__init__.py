@@ -105,13 +105,13 @@ class _RegisterWithGymnasium:
                 break
         else:
             return None
-        exec_module = spec.loader.exec_module  # type: ignore[union-attr]
+        exec_module = spec.loader.exec_module
 
         def exec_and_register(module: ModuleType) -> None:
             exec_module(module)
             _register_env(module)
 
-        spec.loader.exec_module = exec_and_register  # type: ignore[union-attr,method-assign]
+        spec.loader.exec_module = exec_and_register  # type: ignore[method-assign]
         return spec
 
 

@@ -38,7 +38,7 @@ class ScenarioFields(StrictModel):
 
     scenario: str | None = None
     scenario_every: PositiveInt = 20
-    scenario_paper_share: float = Field(0.0, ge=0.0, le=1.0)
+    scenario_paper_share: float = Field(default=0.0, ge=0.0, le=1.0)
     net_file: TextPath | None = None
     route: Annotated[tuple[str, str], FROM_LIST] | None = None
     demand_file: TextPath | None = None
