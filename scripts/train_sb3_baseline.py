@@ -4,7 +4,7 @@ The learner sees the trainer's curriculum through the env's wrappers
 (:mod:`explaindrive.env.wrappers`) with a preset's settings (command, traffic levels, stop
 injections, seed pool, reward, yellow-light rule, scenarios) and acts through the env's
 safety mask (``action_masks()``, the run-time shield's rule). Training stops after the
-preset's episode budget (passenger: 1,600 episodes). The preset's observation noise is not
+preset's episode budget (passenger: 1,200 episodes). The preset's observation noise is not
 applied (no wrapper draws it).
 
 The model is saved as ``maskable_ppo.zip`` with ``sb3_baseline.json`` (its settings). The
@@ -12,7 +12,7 @@ evaluation plays the grid ``explaindrive evaluate`` plays (the paper's seeds 0-4
 traffic levels, the same episode specs) with the model acting through the mask, and prints
 the same tables. Examples::
 
-    python scripts/train_sb3_baseline.py train runs/sb3            # 1,600 episodes
+    python scripts/train_sb3_baseline.py train runs/sb3            # 1,200 episodes
     python scripts/train_sb3_baseline.py evaluate runs/sb3 --json runs/sb3/eval.json
     python scripts/train_sb3_baseline.py train /tmp/sb3 --episodes 3 --max-steps 50
 """
