@@ -42,3 +42,14 @@ def test_scene_missing_file(tmp_path):
 )
 def test_signal_colour(state, index, colour):
     assert signal_colour(state, index) == colour
+
+
+def test_scene_from_a_netgenerate_grid(netgen):
+    from ..conftest import GRID_WITH_LIGHTS
+
+    scene = load_scene(netgen("grid", *GRID_WITH_LIGHTS))
+    # 5 x 5 junctions 200 m apart: 800 m square
+    assert scene.bounds[2] - scene.bounds[0] == 800.0
+    assert scene.bounds[3] - scene.bounds[1] == 800.0
+    assert {lane["kind"] for lane in scene.lanes} >= {"road", "internal"}
+    assert len({s.tls_id for s in scene.signals}) == 25  # every junction has a light

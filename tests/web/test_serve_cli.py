@@ -97,3 +97,26 @@ def test_the_configured_model_reaches_the_endpoint(
 def test_a_missing_language_config_exits_before_serving(tmp_path: Path) -> None:
     res = runner.invoke(app, ["serve", "--config", str(tmp_path / "none.yaml")])
     assert res.exit_code == 2 and "language config not found" in res.output
+
+
+def test_an_own_network_reaches_the_rides_and_the_page(
+    monkeypatch: pytest.MonkeyPatch, netgen
+) -> None:
+    from explaindrive.web import server
+    from explaindrive.web.app import RealStack
+    from tests.conftest import GRID_WITH_LIGHTS
+
+    net = netgen("grid", *GRID_WITH_LIGHTS)
+    served: dict[str, object] = {}
+    monkeypatch.setattr(
+        server, "run_server", lambda app, host, port: served.update(app=app, host=host)
+    )
+    res = runner.invoke(app, ["serve", "--net", str(net), "--route", "A1B1,D1E1"])
+    assert res.exit_code == 0, res.output
+    web_app = served["app"]
+    stack = web_app.state.manager.session_factory  # type: ignore[attr-defined]
+    assert isinstance(stack, RealStack)
+    assert stack.scenario["route"] == ("A1B1", "D1E1")
+    assert Path(stack.scenario["net_file"]) == net
+    bounds = web_app.state.scene.bounds  # type: ignore[attr-defined]
+    assert bounds[2] - bounds[0] == 800.0  # the page draws the 5 x 5 grid, not the paper's road
