@@ -63,7 +63,7 @@ def raw_stretch(env: UrbanDriveEnv, seed: int, traffic: float, speeds: list[floa
         api.trafficlight.unsubscribe(tls_id)
     for edge in api.edge.getIDList():
         api.edge.unsubscribe(edge)
-    pedestrians = PedestrianSource(seed, env.config.max_steps + 1.0, env.scenario.pedestrian_flows)
+    pedestrians = PedestrianSource(seed, env.scenario.pedestrian_flows)
     t0 = time.perf_counter()
     for i, v in enumerate(speeds):
         api.vehicle.setSpeed(EGO_ID, v)
