@@ -52,7 +52,10 @@ def test_unknown_key_is_named() -> None:
             "ego_model: must be one of agent, krauss, idm, got 'wiedemann'",
         ),
         ({"net_file": 3}, "net_file: Input is not a valid path"),
-        ({"yellow_leader": "never"}, "yellow_leader: must be one of decided, always, got 'never'"),
+        (
+            {"yellow_leader": "never"},
+            "yellow_leader: must be one of decided, gentle, always, got 'never'",
+        ),
     ],
 )
 def test_bad_settings_are_rejected(settings: dict[str, object], message: str) -> None:

@@ -1,6 +1,9 @@
 """The decision at yellow: which stop lines are virtual leaders."""
 
-from explaindrive.env.lights import AmberDecision
+import pytest
+
+from explaindrive.env.actions import can_stop_before
+from explaindrive.env.lights import AmberDecision, clears, stops_gently
 from explaindrive.env.state import LightState
 
 GREEN, YELLOW, RED = LightState.GREEN, LightState.YELLOW, LightState.RED
@@ -45,3 +48,44 @@ def test_with_the_papers_rule_every_yellow_is_a_leader() -> None:
     assert amber.is_leader("A", YELLOW, 8.0, 5.9)
     assert amber.is_leader("A", RED, 5.0, 0.9)
     assert not amber.is_leader("A", GREEN, 5.0, 0.9)
+
+
+def test_gentle_rule_stops_where_two_m_s_per_step_will_do() -> None:
+    # from 5 m/s braking by 2: 3 + 1 m, plus the 2 m margin = 6 m <= 20 m
+    amber = AmberDecision.for_rule("gentle")
+    assert stops_gently(5.0, 20.0) and amber.is_leader("A", YELLOW, 5.0, 20.0)
+    assert amber.shown_colour(YELLOW, True) is YELLOW
+
+
+def test_gentle_rule_drives_through_a_yellow_it_clears_in_two_steps() -> None:
+    # 9 m/s, 16.7 m: braking by 2 needs 7 + 5 + 3 + 1 + 2 = 18 m > 16.7 m, though the
+    # hardest braking (6 + 3 + 2 = 11 m) would stop; 2 x 9 = 18 m >= 16.7 + 1 m clears the line
+    amber = AmberDecision.for_rule("gentle")
+    assert not stops_gently(9.0, 16.7) and can_stop_before(9.0, 16.7) and clears(9.0, 16.7)
+    assert not amber.is_leader("A", YELLOW, 9.0, 16.7)
+    assert amber.shown_colour(YELLOW, False) is GREEN
+    assert not amber.is_leader("A", YELLOW, 9.0, 7.7)  # the decision holds
+    # the hardest-braking rule stops there, and shows the yellow as it is
+    decided = AmberDecision.for_rule("decided")
+    assert decided.is_leader("A", YELLOW, 9.0, 16.7)
+    assert decided.shown_colour(YELLOW, False) is YELLOW
+
+
+def test_gentle_rule_stops_hard_where_it_could_not_clear_the_line_in_time() -> None:
+    # 13 m/s, 27 m: braking by 2 needs 11 + 25 + 2 = 38 m, the hardest 10 + 12 + 2 = 24 m;
+    # 2 x 13 = 26 m < 27 + 1 m: going on would still be short of the line at red
+    amber = AmberDecision.for_rule("gentle")
+    assert not stops_gently(13.0, 27.0) and not clears(13.0, 27.0)
+    assert amber.is_leader("A", YELLOW, 13.0, 27.0)
+
+
+def test_gentle_rule_drives_through_the_dilemma_zone_and_red_always_binds() -> None:
+    amber = AmberDecision.for_rule("gentle")
+    assert not amber.is_leader("A", YELLOW, 13.0, 8.0)  # not even the hardest braking stops
+    assert amber.is_leader("A", RED, 13.0, 0.5)
+    assert amber.shown_colour(RED, True) is RED
+
+
+def test_an_unknown_yellow_rule_is_named() -> None:
+    with pytest.raises(ValueError, match="unknown yellow rule 'sometimes'"):
+        AmberDecision.for_rule("sometimes")

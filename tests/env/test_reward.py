@@ -158,16 +158,18 @@ def test_passenger_approach_keeps_a_time_gap_behind_vehicles_only():
     # 8 m/s towards a standing queue 40 m ahead: the room is 40 - 2 - 8 = 30 m
     f = _features(speed_mps=8.0, leader_gap_m=40.0, closing_speed_mps=8.0)
     t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
-    # 64 / 60 = 1.0667 m/s^2: gentle enough
-    assert t.approach == 0.0
+    # 64 / 60 = 1.066667 m/s^2, 0.066667 beyond comfort's free 1.0: 2.0 * 0.066667^2
+    assert t.approach == pytest.approx(-0.008889, abs=1e-6)
+    assert R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE).approach == 0.0  # fast: 1.5
     f = _features(speed_mps=12.0, leader_gap_m=40.0, closing_speed_mps=12.0)
     t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
-    # room 40 - 2 - 12 = 26 m; 144 / 52 = 2.769231 m/s^2; 1.0 * 1.269231^2 = 1.610947
-    assert t.approach == pytest.approx(-1.610947, abs=1e-6)
-    # a stop line 40 m ahead keeps no time gap: 144 / 76 = 1.894737 m/s^2; 0.394737^2
+    # room 40 - 2 - 12 = 26 m; 144 / 52 = 2.769231 m/s^2; 2.0 * 1.769231^2 = 6.260355
+    assert t.approach == pytest.approx(-6.260355, abs=1e-6)
+    # a stop line 40 m ahead keeps no time gap: 144 / 76 = 1.894737 m/s^2; 2.0 * 0.894737^2
     f = _features(speed_mps=12.0, leader_gap_m=40.0, closing_speed_mps=12.0, leader_virtual=True)
     t = R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE)
-    assert t.approach == pytest.approx(-0.155817, abs=1e-6)
+    assert t.approach == pytest.approx(-1.601108, abs=1e-6)
+    # with the default free 1.5 m/s^2 and weight 1: 0.394737^2
     assert R.approach_penalty(40.0, 12.0, 1.0) == pytest.approx(-0.155817, abs=1e-6)
 
 

@@ -254,14 +254,16 @@ after that; training ends early once 200 episodes in a row needed no override.""
 PASSENGER = SAFE.replace(
     episodes=1200,
     reward="passenger",
+    yellow_leader="gentle",
     unsafe_margin=30.0,
     obs_noise_max=(3.0, 0.9),
     stop_when_safe=None,
     scenario="random",
     scenario_paper_share=0.25,
 )
-"""The default: ``safe``'s learning with the ``passenger`` reward recipe over 1,200 episodes
-(the shipped networks' budget), observation noise up to 3 m / 0.9 m/s drawn in half of the
+"""The default: ``safe``'s learning with the ``passenger`` reward recipe and the ``gentle``
+decision at yellow (:mod:`explaindrive.env.lights`) over 1,200 episodes (the shipped
+networks' budget), observation noise up to 3 m / 0.9 m/s drawn in half of the
 episodes, every episode trained (no early end: a run that is safe early still has to learn
 to drive well), on the scenario family: a new scenario every 20 episodes, the paper's road in
 a quarter of the draws and generated ones in the rest."""

@@ -35,7 +35,9 @@ class EnvConfig(ConfigModel, ScenarioFields):
             a standstill (at most 3 m/s^2) and hold it.
         yellow_leader: when a yellow light's stop line is a virtual leader: ``"decided"``
             once, when the ego first sees the yellow, by whether it can still stop there
-            (:mod:`explaindrive.env.lights`), or ``"always"``, as in the paper.
+            (:mod:`explaindrive.env.lights`), ``"gentle"`` (stop where braking by 2 m/s
+            per step will do, or where the car could not clear the line in 2 s), or
+            ``"always"``, as in the paper.
         reward: the reward recipe, ``"paper"`` or ``"passenger"``
             (:mod:`explaindrive.env.reward`).
         obs_noise: ``(sd_m, sd_mps)`` of the Gaussian noise on the observed distances and

@@ -63,6 +63,11 @@ class Episode:
     noise_rng: np.random.Generator = field(default_factory=lambda: np.random.default_rng(0))
 
     @property
+    def light_colour(self) -> S.LightState:
+        """The true colour of the next light in the latest perception (green before any)."""
+        return self.seen.light_colour if self.seen is not None else S.LightState.GREEN
+
+    @property
     def time_s(self) -> float:
         """Seconds since the ego entered."""
         return self.steps * STEP_LENGTH_S
@@ -165,7 +170,7 @@ class StepRecord:
             "real_headway_s": time_headway(real.gap_m, real.length_m, v) if real else math.inf,
             "real_leader_speed_mps": real.speed_mps if real else math.inf,
             "light_gap_m": float(obs[S.D_TL]),
-            "light_state": S.LightState(int(obs[S.TLS])).label,
+            "light_state": ep.light_colour.label,
             "crossing_gap_m": float(obs[S.D_CROSS]),
             "distance_m": ep.pos_m - ep.start_pos_m,
             "collision": self.motion.collided,

@@ -9,21 +9,46 @@ decision when the ego first sees a light yellow, with the ego's hardest braking
 (:func:`~explaindrive.env.actions.can_stop_before`, the rule the run-time shield uses),
 and keeps it while that light stays yellow. A red light is always a virtual leader.
 
-``YELLOW_LEADERS`` names the two rules an environment can use: ``decided`` (the above, the
-default) and ``always``, the paper's own leader at every yellow.
+``YELLOW_LEADERS`` names the rules an environment can use: ``decided`` (the above, the
+default), ``gentle`` and ``always``, the paper's own leader at every yellow.
+
+``gentle`` decides as a passenger would have it: the car stops where it can do so braking at
+:data:`GENTLE_BRAKE_MPS` per step, and also where it could stop only braking harder but could
+not clear the line within :data:`CLEAR_STEPS` steps at its speed (a yellow lasts at least
+3 s, so a car that clears within 2 s is across before red). Where it goes, the light does not
+bind it for the rest of that yellow, and the ego is shown the light as green
+(:meth:`AmberDecision.shown_colour`): the safety rules and the driver then treat the light as
+the decision has it, with no hard braking for a yellow it may legally drive through.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from explaindrive.env.actions import can_stop_before
+from explaindrive.env.actions import STOP_MARGIN_M, braking_distance, can_stop_before
 from explaindrive.env.state import LightState
 
-YELLOW_LEADERS: tuple[str, ...] = ("decided", "always")
-"""When a yellow light is a virtual leader: ``decided`` once by :class:`AmberDecision`, or
-``always`` (the paper)."""
+YELLOW_LEADERS: tuple[str, ...] = ("decided", "gentle", "always")
+"""When a yellow light is a virtual leader: ``decided`` once by :class:`AmberDecision` with
+the hardest braking, ``gentle`` once with gentle braking, or ``always`` (the paper)."""
 DEFAULT_YELLOW_LEADER = "decided"
+GENTLE_BRAKE_MPS = 2.0  # [m/s per step] the braking a ``gentle`` stop at yellow may ask for
+CLEAR_STEPS = 2  # steps within which a car going through a ``gentle`` yellow clears the line
+CLEAR_SLACK_M = 1.0  # [m] it clears the line by at least this much at its speed
+
+
+def stops_gently(speed_mps: float, d_tl: float) -> bool:
+    """Whether a car at ``speed_mps`` can stand :data:`STOP_MARGIN_M` before a line ``d_tl``
+    ahead braking by :data:`GENTLE_BRAKE_MPS` per step from now on."""
+    v = max(speed_mps - GENTLE_BRAKE_MPS, 0.0)
+    need = v + braking_distance(v, GENTLE_BRAKE_MPS) + STOP_MARGIN_M if v > 0.0 else 0.0
+    return need <= d_tl
+
+
+def clears(speed_mps: float, d_tl: float) -> bool:
+    """Whether a car keeping ``speed_mps`` is :data:`CLEAR_SLACK_M` past a line ``d_tl``
+    ahead within :data:`CLEAR_STEPS` steps."""
+    return CLEAR_STEPS * speed_mps >= d_tl + CLEAR_SLACK_M
 
 
 @dataclass(slots=True)
@@ -36,6 +61,8 @@ class AmberDecision:
     """Whether the ego stops for that light's yellow."""
     always: bool = False
     """Every yellow is a leader (the paper's rule): nothing is decided."""
+    gentle: bool = False
+    """Decide by the ``gentle`` rule (module docstring) instead of the hardest braking."""
 
     def is_leader(
         self, light_id: str | None, colour: LightState, speed_mps: float, d_tl: float
@@ -55,5 +82,26 @@ class AmberDecision:
         if self.always:
             return True
         if self.light_id != light_id:
-            self.light_id, self.stops = light_id, can_stop_before(speed_mps, d_tl)
+            stops = can_stop_before(speed_mps, d_tl)
+            if self.gentle:
+                stops = stops and (stops_gently(speed_mps, d_tl) or not clears(speed_mps, d_tl))
+            self.light_id, self.stops = light_id, stops
         return self.stops
+
+    def shown_colour(self, colour: LightState, leader: bool) -> LightState:
+        """The colour the ego is shown for a light whose line :meth:`is_leader` just judged:
+        under the ``gentle`` rule a yellow it goes through is shown green; else ``colour``."""
+        if self.gentle and colour is LightState.YELLOW and not leader:
+            return LightState.GREEN
+        return colour
+
+    @classmethod
+    def for_rule(cls, rule: str) -> AmberDecision:
+        """The decision of one of :data:`YELLOW_LEADERS`.
+
+        Raises:
+            ValueError: for another name.
+        """
+        if rule not in YELLOW_LEADERS:
+            raise ValueError(f"unknown yellow rule {rule!r}; expected one of {YELLOW_LEADERS}")
+        return cls(always=rule == "always", gentle=rule == "gentle")

@@ -7,6 +7,7 @@ writes episode state. :class:`Perception` combines them into a :class:`Percept`.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -75,6 +76,8 @@ class Percept:
         real: the real leader, ``None`` if none in range.
         lane_id: the ego's lane where SUMO changes its lanes (else ``None``).
         crossings: the crossings ahead.
+        light_colour: the true colour of the next light (the observation may show a yellow
+            the ego goes through as green, :meth:`AmberDecision.shown_colour`).
     """
 
     obs: NDArray[np.float32]
@@ -82,6 +85,7 @@ class Percept:
     real: Leader | None
     lane_id: str | None
     crossings: CrossingReading
+    light_colour: S.LightState = S.LightState.GREEN
 
 
 class LeaderSensor:
@@ -298,8 +302,12 @@ class Perception:
         real = self.leaders(api, ego)
         light = self.lights(api, pos_m, lane_id)
         at_line = amber.is_leader(light.light_id, light.colour, v, light.gap_m)
+        true_colour = light.colour
+        shown = amber.shown_colour(true_colour, at_line)
+        if shown is not true_colour:
+            light = dataclasses.replace(light, colour=shown)
         crossings = self.crossings(api, pos_m, kerb)
         leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m)
         limit = self.geometry.posted_limit(pos_m)
         obs = observation(command, v, limit, leader, light, crossings.gap_m)
-        return Percept(obs, leader, real, lane_id, crossings)
+        return Percept(obs, leader, real, lane_id, crossings, true_colour)

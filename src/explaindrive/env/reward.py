@@ -17,7 +17,8 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
   (``hard_brake``), more under comfort;
 * closing in on a leader, a red light or a pedestrian too fast to stop gently is charged
   (``approach``): the deceleration that would just stop in time, as IDM's braking
-  strategy has it, beyond a comfortable 1.5 m/s^2, so the car slows down early; behind a
+  strategy has it, beyond a comfortable 1.5 m/s^2 (1.0 under comfort, charged twice as much
+  there), so the car slows down early; behind a
   vehicle the room to stop in keeps a time gap of ``approach_time_gap_s`` at the car's
   speed, as IDM's desired gap does, so that the car eases off before a queue rather than at
   its tail; before a stop line it keeps only the standstill gap, so that a light turning
@@ -49,7 +50,7 @@ FAST_SPEED_WEIGHT = 3.0
 COMFORT_SPEED_WEIGHT = 1.5
 STOP_REASON_GAP_M = 15.0  # [m] a leader this close justifies standing still
 GENTLE_BRAKE_MPS2 = 1.0  # [m/s^2] braking up to this is not charged by ``hard_brake``
-COMFORT_DECEL_MPS2 = 1.5  # [m/s^2] a stop needing up to this is not charged by ``approach``
+COMFORT_DECEL_MPS2 = 1.5  # [m/s^2] ``approach`` charges no stop needing up to this (default)
 APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
 MAX_NEEDED_MPS2 = 9.0  # [m/s^2] SUMO's emergency braking: ``approach`` charges no further
 CRUISE_SHARE = 0.9  # of the posted limit: ``cruise`` charges free-road driving below it
@@ -68,8 +69,9 @@ class RewardWeights:
         time: charge per step [reward/s].
         jerk: weight of -jerk^2.
         hard_brake: weight of -(braking beyond :data:`GENTLE_BRAKE_MPS2`)^2.
-        approach: weight of -(needed deceleration beyond :data:`COMFORT_DECEL_MPS2`)^2
+        approach: weight of -(needed deceleration beyond ``approach_free_mps2``)^2
             (:func:`approach_penalty`).
+        approach_free_mps2: the needed deceleration [m/s^2] ``approach`` does not charge.
         approach_time_gap_s: the time gap [s] at the car's speed that the approach keeps
             clear of a vehicle ahead besides :data:`APPROACH_STANDSTILL_M` (not of a stop
             line).
@@ -87,6 +89,7 @@ class RewardWeights:
     jerk: float = 0.0
     hard_brake: float = 0.0
     approach: float = 0.0
+    approach_free_mps2: float = COMFORT_DECEL_MPS2
     approach_time_gap_s: float = 0.0
     cruise: float = 0.0
     signal_stop: float = R_RESPECT
@@ -142,7 +145,8 @@ PASSENGER_RECIPE = RewardRecipe(
         time=0.5,
         jerk=1.0,
         hard_brake=3.0,
-        approach=1.0,
+        approach=2.0,
+        approach_free_mps2=1.0,
         approach_time_gap_s=1.0,
         cruise=5.0,
         signal_stop=2.0,
@@ -239,12 +243,16 @@ def needed_deceleration(gap_m: float, closing_speed_mps: float, keep_m: float = 
 
 
 def approach_penalty(
-    gap_m: float, closing_speed_mps: float, weight: float, keep_m: float = 0.0
+    gap_m: float,
+    closing_speed_mps: float,
+    weight: float,
+    keep_m: float = 0.0,
+    free_mps2: float = COMFORT_DECEL_MPS2,
 ) -> float:
-    """-weight * (needed deceleration beyond :data:`COMFORT_DECEL_MPS2`)^2, stopping
-    ``keep_m`` short of the standstill gap; the need is capped at :data:`MAX_NEEDED_MPS2`."""
+    """-weight * (needed deceleration beyond ``free_mps2``)^2, stopping ``keep_m`` short of
+    the standstill gap; the need is capped at :data:`MAX_NEEDED_MPS2`."""
     needed = min(needed_deceleration(gap_m, closing_speed_mps, keep_m), MAX_NEEDED_MPS2)
-    excess = max(0.0, needed - COMFORT_DECEL_MPS2)
+    excess = max(0.0, needed - free_mps2)
     return -weight * excess * excess
 
 
@@ -352,6 +360,7 @@ def reward_terms(
             f.closing_speed_mps,
             w.approach,
             0.0 if f.leader_virtual else w.approach_time_gap_s * f.speed_mps,
+            w.approach_free_mps2,
         ),
         cruise=cruise_penalty(f.speed_mps, f.limit_mps, f.free_road, w.cruise),
     )

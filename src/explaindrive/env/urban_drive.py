@@ -184,7 +184,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             perception=perception,
             judge=ViolationJudge(perception.lights, perception.crossings),
             pedestrians=PedestrianSource(int(sumo_seed), self.scenario.pedestrian_flows),
-            amber=AmberDecision(always=self.config.yellow_leader == "always"),
+            amber=AmberDecision.for_rule(self.config.yellow_leader),
             noise=opts.noise if opts.noise is not None else self.config.noise,
             noise_rng=np.random.default_rng([int(sumo_seed), 17]),
         )
@@ -235,7 +235,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             command=cmd, change=change, accel=accel, jerk=jerk, motion=motion, leader=leader,
             real=real, limit_mps=float(prev_obs[S.V_LIM]), violations=violations,
             free_road=free_road(
-                real.gap_m if real else math.inf, int(obs[S.TLS]) != S.LightState.GREEN,
+                real.gap_m if real else math.inf, ep.light_colour is not S.LightState.GREEN,
                 float(obs[S.D_TL]), float(obs[S.D_CROSS]),
             ),
         )  # fmt: skip
