@@ -90,3 +90,34 @@ def test_score_intents_small_file(tmp_path, interpreter) -> None:  # type: ignor
     r = json.loads(out.read_text())
     assert r["n_commands"] == 2 and r["template_compliance"] == 1.0
     assert r["per_class"]["stop"]["recall"] == 1.0
+
+
+def test_score_intents_on_a_split_sweeps_the_trust_in_a_remote_model(  # type: ignore[no-untyped-def]
+    tmp_path, interpreter, openai_server
+) -> None:
+    data = tmp_path / "c.csv"
+    data.write_text(
+        "text,label,kind,split\n"
+        "Please speed up,fast,direct,dev-1\n"
+        "Go faster please,fast,direct,reserve\n"
+        "Drive gently,comfort,direct,reserve\n"
+        "Play some music,none,offtopic,reserve\n"
+    )
+    # a model that reads every line as comfort
+    openai_server.script = [("ok", "You want me to drive more carefully, is this correct?")]
+    config = tmp_path / "llm.yaml"
+    config.write_text(f"openai: {{base_url: {openai_server.base_url!r}, timeout_s: 5}}\n")
+    out = tmp_path / "r.json"
+    args = ["score", "intents", "--data", str(data), "--split", "reserve", "--backend", "openai"]
+    res = runner.invoke(app, [*args, "--config", str(config), "--json", str(out)])
+    assert res.exit_code == 0, res.output
+    r = json.loads(out.read_text())
+    assert r["n"] == 3 and r["split"] == "reserve" and len(openai_server.requests) == 3
+    sweep = {row["sure_p"]: row for row in r["trust_sweep"]}
+    # trusting the embedded reading always: its readings, all right
+    assert sweep[0.0]["accuracy"] == 1.0 and sweep[0.0]["none_rejection"] == 1.0
+    # trusting the model over any reading: fast and the remark become comfort
+    assert sweep[1.0]["accuracy"] == 0.5 and sweep[1.0]["none_rejection"] == 0.0
+    assert "trust_embedded_from" in res.output
+    res = runner.invoke(app, ["score", "intents", "--data", str(data), "--split", "dev-2"])
+    assert res.exit_code != 0 and "no rows of split 'dev-2'" in res.output

@@ -44,18 +44,31 @@ def intents_command(
             "--data", help="CSV text,label[,kind][,split].", show_default=SHIPPED_COMMANDS
         ),
     ] = None,
+    split: Annotated[
+        str | None,
+        typer.Option(
+            "--split",
+            help="Score only the rows of this split (column split), e.g. reserve in "
+            "commands_train.csv, the split to choose a model's trust_embedded_from on.",
+        ),
+    ] = None,
     backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
     out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
     model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
-    """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1."""
+    """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1; with a
+    remote model, also the figures each trust_embedded_from would give on its replies."""
     from explaindrive.language.datasets import TEST_CSV, data_path, load_commands
 
     refuse_bad_outputs(files=((out, "--json"),))
     data = data or data_path(TEST_CSV)
     try:
         rows = load_commands(data)
+        if split is not None:
+            rows = [r for r in rows if r.split == split]
+            if not rows:
+                raise ValueError(f"{data}: no rows of split {split!r}")
         from explaindrive.language.stack import make_language_stack
 
         stack = make_language_stack(backend, load_config(config, model)).load()
@@ -64,8 +77,9 @@ def intents_command(
     from explaindrive.language.evaluation import evaluate_intents
 
     report = evaluate_intents(stack.interpreter, rows)
-    report.update(backend=stack.backend, data=str(data))
-    table = Table(title=f"LLM-1 on {data.name} ({stack.backend})")
+    report.update(backend=stack.backend, data=str(data), split=split)
+    where = data.name if split is None else f"{data.name}, split {split}"
+    table = Table(title=f"LLM-1 on {where} ({stack.backend})")
     for col in ("class", "precision", "recall", "F1", "support"):
         table.add_column(col, justify="right")
     for name, m in report["per_class"].items():
@@ -86,7 +100,21 @@ def intents_command(
         f"negated stops read as STOP {report['negated_stops_read_as_stop']}",
         highlight=False,
     )
+    if "trust_sweep" in report:
+        sweep = Table(title="the same replies with another trust_embedded_from")
+        for col in ("trust_embedded_from", "accuracy", "off-topic left", "STOP recall"):
+            sweep.add_column(col, justify="right")
+        for r in report["trust_sweep"]:
+            sweep.add_row(
+                f"{r['sure_p']:.2f}",
+                *(_fmt(r[k]) for k in ("accuracy", "none_rejection", "stop_recall")),
+            )
+        console.print(sweep)
     _write(out, report)
+
+
+def _fmt(x: float | None) -> str:
+    return "-" if x is None else f"{x:.3f}"
 
 
 def decisions_command(

@@ -86,6 +86,12 @@ class OpenAIConfig(LaxModel):
     decision_temperature: float = Field(default=0.0, ge=0.0, le=2.0)
     explain_temperature: float = Field(default=0.2, ge=0.0, le=2.0)
     max_tokens: int = Field(default=120, ge=8)
+    trust_embedded_from: float = Field(default=0.8, ge=0.0, le=1.0)
+    """The embedded reading's probability from which a different reading of the model does
+    not replace it (:mod:`explaindrive.language.agreement`): 0 leaves every reading to the
+    embedded interpreter, 1 lets the model change any reading it does not share but a STOP.
+    Choose it per model with ``explaindrive score intents --backend openai --data`` on the
+    ``reserve`` split (docs/language.md)."""
 
 
 class LanguageConfig(LaxModel):

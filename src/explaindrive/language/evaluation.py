@@ -14,6 +14,7 @@ from sklearn.metrics import (
 )
 
 from explaindrive.commands import COMMAND_LABELS
+from explaindrive.language.agreement import TwoReadings, trust_sweep
 from explaindrive.language.datasets import CommandExample, LabelledRecord
 from explaindrive.language.decision import ExplanationDecider
 from explaindrive.language.explanation import Explainer, check_grounding, present_factors
@@ -92,6 +93,9 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
     ``vetoed`` (read, but overruled by a sure embedded reading) and ``not_asked`` (the
     embedded STOP lane, or an empty line). ``by_kind`` gives [correct, total] per kind;
     ``negated_stops_read_as_stop`` counts the rows of kind ``negated_stop`` read as STOP.
+    With a remote model, ``trust_sweep`` gives the figures each ``trust_embedded_from`` of
+    :data:`~explaindrive.language.agreement.TRUST_GRID` would have given on the same
+    replies (:func:`~explaindrive.language.agreement.trust_sweep`).
     """
     preds: list[str] = []
     confs: list[str | None] = []
@@ -99,9 +103,14 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
     replies = {"accepted": 0, "fallback": 0, "vetoed": 0, "not_asked": 0}
     by_kind: dict[str, list[int]] = {}
     errors = []
+    both: list[TwoReadings] = []
     for row in rows:
         r = interpreter.interpret(row.text)
         label = r.intent.label if r.intent is not None else "none"
+        if r.readings is not None:
+            both.append(TwoReadings(row.label, r.readings[0], r.readings[1], r.readings[2], True))
+        else:  # the embedded reading stood alone (a fallback, the STOP lane, no remote)
+            both.append(TwoReadings(row.label, r.intent, 1.0, None, False))
         preds.append(label)
         confs.append(r.confirmation)
         latencies.append(r.latency_s)
@@ -137,6 +146,8 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
         ),
         latency=_percentiles(latencies),
     )
+    if any(x.readable for x in both):
+        out["trust_sweep"] = trust_sweep(both)
     return out
 
 

@@ -51,6 +51,9 @@ class IntentResult:
             against it (rules ``local-sure-none`` and ``local-sure``).
         raw_reply: the remote model's reply as it came, for the ride log only (the
             passenger sees ``confirmation``).
+        readings: when a remote reply was read, the two readings the agreement policy
+            chose between: ``(embedded reading, its probability, remote reading)``, a
+            reading ``None`` meaning "not a driving request"; else ``None``.
     """
 
     intent: Command | None
@@ -65,6 +68,7 @@ class IntentResult:
     rule: str | None = None
     overruled: bool = False
     raw_reply: str | None = None
+    readings: tuple[Command | None, float, Command | None] | None = None
 
     def to_json(self) -> dict[str, object]:
         """The CLI's JSON shape."""

@@ -238,7 +238,14 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             log.warning("openai intent failed, using embedded: %s", error)
             return _as_fallback(local, t0, error, raw)
         label = local.intent.label if local.intent is not None else "none"
-        verdict = reconcile(local.intent, local.scores.get(label, 0.0), reading.command, NAME)
+        local_p = local.scores.get(label, 0.0)
+        verdict = reconcile(
+            local.intent,
+            local_p,
+            reading.command,
+            NAME,
+            self.client.config.trust_embedded_from,
+        )
         if verdict.source != "both":
             log.info("intent readings differ for %r: %s (%s)", text, verdict.intent, verdict.rule)
         own = verdict.source == "embedded"
@@ -253,6 +260,7 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             rule=verdict.rule,
             overruled=own,
             raw_reply=raw,
+            readings=(local.intent, local_p, reading.command),
         )
 
 
