@@ -6,7 +6,7 @@ import pytest
 
 from explaindrive.config import ConfigError
 from explaindrive.sim.scenario.layout import EGO_ROUTE_NODES, make_layout
-from explaindrive.sim.scenario.params import ScenarioParams
+from explaindrive.sim.scenario.params import ScenarioParams, min_yellow_s
 
 
 def test_the_defaults_are_the_papers_road() -> None:
@@ -45,3 +45,19 @@ def test_bad_settings_are_named(settings: list[str], message: str) -> None:
     with pytest.raises(ConfigError, match=None) as err:
         ScenarioParams.from_settings(settings)
     assert message in str(err.value)
+
+
+@pytest.mark.parametrize(("limit_kmh", "yellow_s"), [(30, 3), (50, 3), (60, 4), (70, 4)])
+def test_the_shortest_yellow_leaves_no_dilemma_zone(limit_kmh: float, yellow_s: int) -> None:
+    assert min_yellow_s(limit_kmh) == yellow_s
+
+
+def test_a_yellow_too_short_for_the_road_is_refused() -> None:
+    # 60 km/h: at 16 m/s braking by 3 needs 13 + 10 + 7 + 4 + 1 + 2 = 37 m, and 2 steps at
+    # 16 m/s cover 32 m: a car that sees a 3 s yellow 33-36 m out can neither stop nor cross
+    with pytest.raises(
+        ConfigError, match="j1: yellow_s 3 s is too short for a 60 km/h road; at least 4 s"
+    ):
+        ScenarioParams.from_settings(["limit_kmh=60"])
+    p = ScenarioParams.from_settings(["limit_kmh=60", "j1.yellow_s=4", "j2.yellow_s=4"])
+    assert (p.j1.yellow_s, p.j2.yellow_s) == (4, 4)

@@ -13,7 +13,7 @@ from typing import Any, Literal
 import numpy as np
 
 from explaindrive.sim.scenario.limits import validate_seed
-from explaindrive.sim.scenario.params import SIGNAL_FIXED_S, ScenarioParams
+from explaindrive.sim.scenario.params import SIGNAL_FIXED_S, ScenarioParams, min_yellow_s
 
 TRAIN_SEED_START = 1_000_000
 """Scenario seeds of training draws start here; evaluation seeds lie below."""
@@ -35,7 +35,7 @@ RANGES: dict[str, tuple[float, float, float]] = {
     "side_limit_kmh": (30, 60, 10),
     "cycle_s": (50, 100, 5),
     "main_share": (0.5, 0.75, 0.05),  # of the green time a cycle leaves, to the main road
-    "yellow_s": (3, 4, 1),
+    "yellow_s": (3, 4, 1),  # and at least min_yellow_s of limit_kmh
     "all_red_s": (1, 2, 1),
     "zebra_peds_per_hour": (0, 200, 10),
     "j2_peds_per_hour": (0, 200, 10),
@@ -62,7 +62,8 @@ def _params(pick: Any) -> ScenarioParams:
     offset_j2 = None
     for light in ("j1", "j2"):
         cycle, share, yellow, all_red = (pick(k) for k in _SIGNAL_KEYS)
-        cycle, yellow, all_red = int(cycle), int(yellow), int(all_red)
+        cycle, all_red = int(cycle), int(all_red)
+        yellow = max(int(yellow), min_yellow_s(data["limit_kmh"]))
         green = cycle - 2 * (yellow + all_red) - SIGNAL_FIXED_S[light.upper()]
         offset = 0 if light == "j1" else int(pick("offset") * cycle) % cycle
         offset_j2 = offset if light == "j2" else offset_j2

@@ -30,6 +30,35 @@ the next junction."""
 PedRate = Annotated[float, Field(ge=0.0, le=400.0)]
 """Pedestrians per hour in one direction (0: none)."""
 
+YELLOW_BRAKE_MPS = 3.0  # [m/s per step] the braking a yellow must leave time for
+YELLOW_STOP_MARGIN_M = 2.0  # [m] short of the line a car braking that hard stands
+MAX_YELLOW_S = 5
+
+
+def _hardest_stop_m(speed_mps: float) -> float:
+    """[m] a car at ``speed_mps`` covers braking by :data:`YELLOW_BRAKE_MPS` per 1 s step from
+    now, plus :data:`YELLOW_STOP_MARGIN_M`."""
+    covered, v = YELLOW_STOP_MARGIN_M, speed_mps - YELLOW_BRAKE_MPS
+    while v > 0.0:
+        covered, v = covered + v, v - YELLOW_BRAKE_MPS
+    return covered
+
+
+def min_yellow_s(limit_kmh: float) -> int:
+    """The shortest yellow [s] that leaves no dilemma zone before a light approached at up
+    to ``limit_kmh``: at any speed up to the limit (whole m/s and the limit itself), a car
+    that sees the yellow can either stand before the line braking by 3 m/s per step, or
+    cross it keeping its speed before the red (in yellow minus one steps). 3 s up to
+    50 km/h, 4 s at 60 and 70 km/h. A 3 s yellow at 60 km/h leaves a car at 16 m/s, 33-36 m
+    out, no legal way but to speed up."""
+    top = limit_kmh / 3.6
+    speeds = [*range(1, int(top) + 1), top]
+    for yellow in range(3, MAX_YELLOW_S + 1):
+        if all(_hardest_stop_m(v) <= (yellow - 1) * v for v in speeds):
+            return yellow
+    return MAX_YELLOW_S
+
+
 SIGNAL_FIXED_S = {"J1": 0, "J2": 3}
 """[s] phases a light has besides greens, yellows and all-reds: J2 keeps its side road green
 3 s after its pedestrians' green ends (the crossing clears)."""
@@ -43,8 +72,8 @@ class SignalParams(StrictModel):
     """Cycle length [s]."""
     main_green_s: int = Field(ge=10, le=100)
     """Green of the main road [s] (the split); the side road gets the rest of the cycle."""
-    yellow_s: int = Field(default=3, ge=3, le=5)
-    """Yellow after each green [s]."""
+    yellow_s: int = Field(default=3, ge=3, le=MAX_YELLOW_S)
+    """Yellow after each green [s]; at least :func:`min_yellow_s` of the road's limit."""
     all_red_s: int = Field(default=2, ge=1, le=3)
     """All-red clearance after each yellow [s]."""
     offset_s: int = Field(default=0, ge=0, le=119)
@@ -124,6 +153,13 @@ class ScenarioParams(ConfigModel):
                     f"{name}: the side road's green would be {side} s (cycle_s minus "
                     f"main_green_s and the yellow/all-red/clearance phases); at least "
                     f"{MIN_SIDE_GREEN_S} s is needed"
+                )
+            shortest = min_yellow_s(self.limit_kmh)
+            if signal.yellow_s < shortest:
+                raise ValueError(
+                    f"{name}: yellow_s {signal.yellow_s} s is too short for a "
+                    f"{self.limit_kmh:g} km/h road; at least {shortest} s, or a car that sees "
+                    "the yellow can neither stop nor cross before red"
                 )
             if signal.offset_s >= signal.cycle_s:
                 raise ValueError(f"{name}: offset_s must be below cycle_s ({signal.cycle_s})")
