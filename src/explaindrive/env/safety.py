@@ -36,7 +36,6 @@ from explaindrive.env.actions import (
     action_index,
     braking_distances,
     stopping_needs,
-    stops_before,
 )
 
 LEADER_BRAKE_MPS = 9.0  # [m/s per step] how hard a real leader may brake (SUMO emergency decel)
@@ -75,7 +74,7 @@ def safe_action_mask(
     v_new = np.maximum(v + _CHANGES, 0.0)  # (B, 7)
     need = stopping_needs(v_new)
 
-    safe = _within_limit(x)
+    safe = _within_limit(x, v_new)
 
     d_cross = x[:, S.D_CROSS : S.D_CROSS + 1]
     safe &= ~((d_cross < S.SENSOR_RANGE_M) & (need > d_cross))
@@ -83,7 +82,8 @@ def safe_action_mask(
     d_tl = x[:, S.D_TL : S.D_TL + 1]
     tls = np.rint(x[:, S.TLS : S.TLS + 1])
     light = (d_tl < S.SENSOR_RANGE_M) & (tls != 0)
-    must_go = light & (tls == 1) & ~stops_before(v, d_tl)
+    # the hardest braking's need is what stopping from now on needs (``stops_before``)
+    must_go = light & (tls == 1) & ~(need[:, HARDEST_BRAKE : HARDEST_BRAKE + 1] <= d_tl)
     safe &= ~(light & ~must_go & (need > d_tl))
     if not dilemma_braking:
         safe &= ~(must_go & (v_new < v))
@@ -104,11 +104,14 @@ def safe_action_mask(
     return safe[0] if single else safe
 
 
-def _within_limit(x: NDArray[np.float64]) -> NDArray[np.bool_]:
+def _within_limit(
+    x: NDArray[np.float64], v_new: NDArray[np.float64] | None = None
+) -> NDArray[np.bool_]:
     """Rows ``(B, 8)`` -> ``(B, 7)``: the actions that keep within the posted limit; above
-    it, only the hardest braking."""
+    it, only the hardest braking. ``v_new``: the speeds after each action, if computed."""
     v = x[:, S.V_EGO : S.V_EGO + 1]
-    v_new = np.maximum(v + _CHANGES, 0.0)
+    if v_new is None:
+        v_new = np.maximum(v + _CHANGES, 0.0)
     return ~((v_new > x[:, S.V_LIM : S.V_LIM + 1]) & (v_new > v - MAX_BRAKE_MPS + 1e-9))
 
 
