@@ -13,6 +13,7 @@ import numpy as np
 
 from explaindrive.commands import Command
 from explaindrive.env.actions import N_ACTIONS, speed_change
+from explaindrive.env.safety import runtime_mask
 from explaindrive.env.state import SENSOR_RANGE_M, STATE_DIM, STATE_HIGH, STATE_LOW
 
 V_LIM_MPS = 10.0
@@ -51,6 +52,10 @@ class FakeDriveEnv(gym.Env[np.ndarray, int]):
             dtype=np.float32,
         )  # fmt: skip
 
+    def _true_obs(self) -> np.ndarray:
+        """The true state (what ``info["action_mask"]`` is computed on, as in the real env)."""
+        return self._obs()
+
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         if seed in self.fail_seeds:
             raise RuntimeError(f"the ego could not enter (seed {seed})")
@@ -63,7 +68,9 @@ class FakeDriveEnv(gym.Env[np.ndarray, int]):
         self.v = float(self.np_random.integers(0, 3))
         self.x = 0.0
         self.t = 0
-        return self._obs(), {"command": self.command.label}
+        return self._obs(), {
+            "command": self.command.label, "action_mask": runtime_mask(self._true_obs())
+        }  # fmt: skip
 
     def step(self, action: int):
         if self.step_delay_s:
@@ -88,5 +95,6 @@ class FakeDriveEnv(gym.Env[np.ndarray, int]):
             "command": cmd.label, "speed_mps": self.v, "distance_m": self.x,
             "time_s": float(self.t), "collision": False, "red_light_run": False,
             "ped_violation": False, "speeding": self.v > V_LIM_MPS, "reward_terms": {},
+            "action_mask": runtime_mask(self._true_obs()),
         }  # fmt: skip
         return self._obs(), reward, terminated, truncated, info

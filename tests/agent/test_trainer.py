@@ -23,6 +23,7 @@ from explaindrive.agent.rollout import NStepQueue
 from explaindrive.agent.run_log import moving_average
 from explaindrive.agent.schedule import plan_episode
 from explaindrive.agent.trainer import train
+from explaindrive.env.safety import runtime_mask
 from tests.agent.fake_drive_env import FakeDriveEnv
 
 EPISODE_STEPS = 20
@@ -223,9 +224,9 @@ class NearTheLimit(FakeDriveEnv):
     """Starts every episode at 9 m/s, 1 m/s under the limit."""
 
     def reset(self, *, seed=None, options=None):  # type: ignore[no-untyped-def]
-        super().reset(seed=seed, options=options)
+        _, info = super().reset(seed=seed, options=options)
         self.v = 9.0
-        return self._obs(), {}
+        return self._obs(), {**info, "action_mask": runtime_mask(self._obs())}
 
 
 def test_safe_learning_ends_the_run_once_episodes_run_clean(tmp_path: Path) -> None:

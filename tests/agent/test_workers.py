@@ -102,6 +102,9 @@ class _NoisySensor(FakeDriveEnv):
 
     true = np.array([0, 13.0, 13.9, 17.9, 13.0, 17.9, 1.0, 200.0], dtype=np.float32)
 
+    def _true_obs(self) -> np.ndarray:
+        return self.true
+
     def reset(self, *, seed=None, options=None):  # type: ignore[no-untyped-def]
         obs, info = super().reset(seed=seed, options=options)
         return obs, {**info, "true_obs": self.true}

@@ -30,7 +30,7 @@ from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.schedule import EpisodePlan, plan_episode
-from explaindrive.agent.shield import limit_mask, runtime_mask, training_mask
+from explaindrive.agent.shield import limit_mask, training_mask
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.sim.scenario.layout import SEED_LIMIT
 
@@ -81,6 +81,12 @@ def _true_state(obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
     network that sees noisy observations learns the margin the noise calls for."""
     true = info.get("true_obs")
     return obs if true is None else np.asarray(true, dtype=np.float32)
+
+
+def _allowed(info: dict[str, Any]) -> np.ndarray:
+    """The actions the run-time shield keeps in the true state: the env's
+    ``info["action_mask"]`` (:func:`~explaindrive.env.safety.runtime_mask` of it)."""
+    return np.asarray(info["action_mask"], dtype=bool)
 
 
 def learning_mask(seen: np.ndarray, true: np.ndarray, dilemma_braking: bool) -> np.ndarray:
@@ -272,7 +278,7 @@ class RolloutWorker:
             return _Running(
                 plan, summary, NStepQueue(c.n_step, c.gamma),
                 np.random.default_rng([c.seed, 3, plan.index]), obs,
-                learning_mask(obs, true_obs, c.dilemma_braking), runtime_mask(true_obs),
+                learning_mask(obs, true_obs, c.dilemma_braking), _allowed(info),
             )  # fmt: skip
         raise RuntimeError(
             f"worker {self.worker_id}: episode {plan.index} failed to start "
@@ -295,7 +301,7 @@ class RolloutWorker:
         )
         out.steps += 1
         ep.summary.record(float(reward), info, greedy_unsafe)
-        ep.obs, ep.mask, ep.allowed = next_obs, next_mask, runtime_mask(next_true)
+        ep.obs, ep.mask, ep.allowed = next_obs, next_mask, _allowed(info)
         if done:
             ep.summary.terminated = bool(terminated)
             ep.summary.ended_at_step = out.steps
