@@ -118,6 +118,7 @@ BATTERY: list[tuple[list[str], str]] = [
     ),
     (["scenario", "plot", "--out", "adir"], "error: --out adir is a folder; name a file"),
     (["report", "--out", "adir"], "error: --out adir is a folder; name a file"),
+    (["report", "--external", "nope.json"], "error: evaluation file not found: nope.json"),
     (
         ["report", "--json", "afile/r.json"],
         "error: --json afile/r.json: afile is a file, not a folder",

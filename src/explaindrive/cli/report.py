@@ -47,6 +47,15 @@ SeedTableOption = Annotated[
     list[Path] | None,
     typer.Option("--seed-table", help="A seeds.md of train --seeds to include (repeatable)."),
 ]
+ExternalOption = Annotated[
+    list[Path] | None,
+    typer.Option(
+        "--external",
+        help="An evaluation JSON of a driver evaluated elsewhere on the same seeds and levels "
+        "(e.g. scripts/train_sb3_baseline.py evaluate --json), added to the tables "
+        "(repeatable).",
+    ),
+]
 GeneralisationOption = Annotated[
     bool,
     typer.Option(
@@ -72,16 +81,22 @@ def report_command(
     ray_address: grid.RayAddressOption = None,
     max_steps: grid.MaxStepsOption = 1000,
     seed_tables: SeedTableOption = None,
+    external: ExternalOption = None,
     generalisation: GeneralisationOption = True,
 ) -> None:
     """Evaluate the policies and baselines and rewrite the results document and figures."""
-    from explaindrive.evaluation.report import run_report
+    from explaindrive.evaluation.report import external_runs, run_report
 
     refuse_bad_outputs(
         files=((out, "--out"), (json_file, "--json")), folders=((figures, "--figures"),)
     )
     plan = _plan(policies, episodes_per_cell, traffic, fast_policy, comfort_policy, max_steps,
                  shield, ray, ray_address, seed_tables or [])  # fmt: skip
+    try:
+        stored = external_runs(plan, external or [])
+    except ValueError as exc:
+        print_error(exc)
+        raise typer.Exit(2) from None
     n = sum(len(run.episodes) for run in plan.runs)
     err_console.print(f"report: {len(plan.runs)} runs, {n} episodes")
     with grid.episode_progress("episodes", n) as progress:
@@ -89,7 +104,7 @@ def report_command(
             plan, out, figures_dir=figures, training_runs=_training_logs(plan, runs_dir),
             json_file=json_file, workers=workers, use_ray=ray, ray_address=ray_address,
             command_line="explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
-            progress=progress, seed_tables=seed_tables or [],
+            progress=progress, seed_tables=seed_tables or [], external=stored,
         )  # fmt: skip
     markdown = result.markdown
     if generalisation:

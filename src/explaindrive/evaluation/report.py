@@ -18,7 +18,7 @@ from explaindrive.evaluation.paper import PAPER_MERGED_COMMANDS
 from explaindrive.evaluation.report_plan import ReportPlan
 from explaindrive.evaluation.report_sections import results_markdown, seeds_section, shield_section
 from explaindrive.evaluation.runner import EpisodeRecord, Progress, run_grid
-from explaindrive.evaluation.schema import run_document, write_json
+from explaindrive.evaluation.schema import StoredRun, read_runs, run_document, write_json
 from explaindrive.evaluation.spec import AGENTS, BASELINES, MERGED
 
 log = logging.getLogger(__name__)
@@ -53,6 +53,7 @@ def run_report(
     ray_address: str | None = None,
     progress: Progress | None = None,
     seed_tables: Sequence[Path] = (),
+    external: Mapping[str, tuple[StoredRun, str]] | None = None,
 ) -> ReportResult:
     """Evaluate every run of ``plan``, write the figures, and return the document's Markdown.
 
@@ -68,7 +69,10 @@ def run_report(
         ray_address: run on this Ray cluster.
         progress: called after each finished episode.
         seed_tables: ``seeds.md`` files of ``train --seeds`` runs to include.
+        external: runs of drivers evaluated elsewhere, from :func:`external_runs`; they join
+            the tables.
     """
+    stored = external or {}
     figures_dir = figures_dir or out_md.parent / "figures"
     specs = [ep for run in plan.runs for ep in run.episodes]
     records = run_grid(specs, workers=workers, use_ray=use_ray, ray_address=ray_address,
@@ -82,12 +86,42 @@ def run_report(
         name: summarize(name, [(r.spec.traffic_level, r.result) for r in recs])
         for name, recs in by_run.items()
     }
+    for name, (ext, _what) in stored.items():
+        summaries[name] = summarize(name, [(lvl, res) for lvl, _s, res in ext.episodes])
     written = _figures(plan, by_run, figures_dir, training_runs or {})
     if json_file is not None:
         write_json(json_file, [run_document(name, recs) for name, recs in by_run.items()])
-    md = results_markdown(plan, summaries, by_run, written, out_md, command_line)
+    described = {name: what for name, (_run, what) in stored.items()}
+    md = results_markdown(plan, summaries, by_run, written, out_md, command_line, described)
     md += shield_section(plan, by_run) + seeds_section(seed_tables)
     return ReportResult(md, written, by_run)
+
+
+def external_runs(plan: ReportPlan, files: Sequence[Path]) -> dict[str, tuple[StoredRun, str]]:
+    """The runs of evaluation files (:func:`~explaindrive.evaluation.schema.write_json`) of
+    drivers evaluated elsewhere, such as a Stable-Baselines3 model, by name, each with a line
+    saying what it is.
+
+    Raises:
+        ValueError: for a file that cannot be read, a run off the report's grid (its seeds
+            and traffic levels) or one named like another run.
+    """
+    taken = {run.name for run in plan.runs}
+    out: dict[str, tuple[StoredRun, str]] = {}
+    for path in files:
+        for run in read_runs(path):
+            if run.name in taken or run.name in out:
+                raise ValueError(f"{path}: run {run.name!r} has the name of another run")
+            cells = sorted((lvl, seed) for lvl, seed, _r in run.episodes)
+            grid = sorted((lvl, seed) for lvl in plan.levels for seed in plan.seeds)
+            if cells != grid:
+                raise ValueError(
+                    f"{path}: run {run.name!r} is not on the report's grid (seeds "
+                    f"{list(plan.seeds)} x levels {list(plan.levels)})"
+                )
+            what = f"evaluated outside the report, read from `{path}`"
+            out[run.name] = (run, what)
+    return out
 
 
 def _speed_panels(

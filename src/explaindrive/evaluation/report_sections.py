@@ -75,12 +75,15 @@ def results_markdown(
     written: Sequence[Path],
     out_md: Path,
     command_line: str,
+    external: Mapping[str, str] | None = None,
 ) -> str:
-    """The document: how it was made, the policies, the tables, the figures, the discussion."""
+    """The document: how it was made, the policies, the tables, the figures, the discussion.
+    ``external`` names runs of ``summaries`` read from evaluation files, with what each is."""
+    external = external or {}
     lines = [
         *_introduction(plan, command_line),
-        *_policy_lines(plan),
-        *_result_tables(plan, summaries),
+        *_policy_lines(plan, external),
+        *_result_tables(plan, summaries, external),
         *_merged_section(by_run),
         *_figure_links(written, out_md),
         "## Discussion",
@@ -107,7 +110,7 @@ def _introduction(plan: ReportPlan, command_line: str) -> list[str]:
     ]
 
 
-def _policy_lines(plan: ReportPlan) -> list[str]:
+def _policy_lines(plan: ReportPlan, external: Mapping[str, str]) -> list[str]:
     """The Policies section: one line saying what each policy is."""
     lines = ["## Policies", ""]
     for name, spec in plan.policies.items():
@@ -120,13 +123,16 @@ def _policy_lines(plan: ReportPlan) -> list[str]:
         else:
             what = f"SUMO {name.upper()} car-following drives the ego (SUMO safety on)"
         lines.append(f"- **{name}**: {what}")
+    lines += [f"- **{name}**: {what}" for name, what in external.items()]
     return [*lines, ""]
 
 
-def _result_tables(plan: ReportPlan, summaries: Mapping[str, RunSummary]) -> list[str]:
+def _result_tables(
+    plan: ReportPlan, summaries: Mapping[str, RunSummary], external: Mapping[str, str]
+) -> list[str]:
     """The paper's table, per traffic level, safety, and the runs with stop injections."""
     grid = [s for name, s in summaries.items() if name != MERGED]
-    plain = [summaries[n] for n in plan.policies if n in summaries]
+    plain = [summaries[n] for n in [*plan.policies, *external] if n in summaries]
     agents = [summaries[n] for n in plan.policies if n in AGENTS and n in summaries]
     stop_runs = [s for name, s in summaries.items() if name.endswith("+ stops")]
     lines = [

@@ -32,6 +32,8 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+from explaindrive.env.metrics import EpisodeResult
+from explaindrive.env.ride_quality import RideQualityResult
 from explaindrive.evaluation.aggregate import aggregate, aggregate_by_level
 from explaindrive.evaluation.paper import paper_row
 from explaindrive.evaluation.runner import EpisodeRecord
@@ -118,3 +120,57 @@ def write_json(path: Path, runs: Sequence[dict[str, Any]]) -> Path:
     # Paper rows have float keys; JSON object keys become strings.
     path.write_text(json.dumps(doc, indent=1, allow_nan=False, default=str) + "\n", "utf-8")
     return path
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class StoredRun:
+    """One run read back from an evaluation file: its name, what drove and its episodes as
+    ``(traffic level, seed, result)``."""
+
+    name: str
+    policy: dict[str, Any]
+    episodes: tuple[tuple[float, int, EpisodeResult], ...]
+
+
+def read_runs(path: Path) -> list[StoredRun]:
+    """The runs of an evaluation file (:func:`write_json`), for example one that a driver
+    evaluated outside ``explaindrive evaluate`` wrote.
+
+    Raises:
+        ValueError: naming the file and what is wrong with it (missing, not JSON, another
+            schema, a run or an episode without its figures).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"evaluation file not found: {path}")
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{path} is not JSON: {exc}") from None
+    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA_NAME:
+        raise ValueError(f"{path} is not an {SCHEMA_NAME} file (no schema {SCHEMA_NAME!r})")
+    runs = []
+    for k, run in enumerate(doc.get("runs") or []):
+        try:
+            episodes = tuple(
+                (float(ep["traffic_level"]), int(ep["seed"]), _result(ep["metrics"]))
+                for ep in run["episodes"]
+            )
+            runs.append(StoredRun(str(run["name"]), dict(run.get("policy") or {}), episodes))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"{path}: run {k} cannot be read: {exc!r}") from None
+        if not episodes:
+            raise ValueError(f"{path}: run {run['name']!r} has no episodes (written with "
+                             "--no-episodes?)")  # fmt: skip
+    if not runs:
+        raise ValueError(f"{path} holds no runs")
+    return runs
+
+
+def _result(metrics: dict[str, Any]) -> EpisodeResult:
+    """An :class:`EpisodeResult` from its :meth:`~EpisodeResult.as_dict`."""
+    ride = dict(metrics["ride"])
+    for key in ("light_stop_gaps_m", "crossing_stop_gaps_m"):
+        ride[key] = tuple(ride[key])
+    fields = {**metrics, "stop_latencies": tuple(metrics["stop_latencies"])}
+    return EpisodeResult(**{**fields, "ride": RideQualityResult(**ride)})
