@@ -14,6 +14,7 @@ the same tables. Examples::
 
     python scripts/train_sb3_baseline.py train runs/sb3            # 1,200 episodes
     python scripts/train_sb3_baseline.py evaluate runs/sb3 --json runs/sb3/eval.json
+    explaindrive report --external runs/sb3/eval.json    # beside the D3QN in docs/results.md
     python scripts/train_sb3_baseline.py train /tmp/sb3 --episodes 3 --max-steps 50
 """
 
