@@ -68,6 +68,16 @@ class EpisodeResult:
         d["ride"] = self.ride.as_dict()
         return d
 
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> EpisodeResult:
+        """The inverse of :meth:`as_dict` (an evaluation file's episode ``metrics``).
+
+        Raises:
+            KeyError, TypeError: for a dict that lacks a field or holds another.
+        """
+        return cls(**{**d, "stop_latencies": tuple(d["stop_latencies"]),
+                      "ride": RideQualityResult.from_dict(d["ride"])})  # fmt: skip
+
 
 def _mean(values: list[float]) -> float | None:
     return sum(values) / len(values) if values else None

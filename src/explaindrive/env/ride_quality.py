@@ -65,6 +65,16 @@ class RideQualityResult:
         d["crossing_stop_gaps_m"] = list(self.crossing_stop_gaps_m)
         return d
 
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> RideQualityResult:
+        """The inverse of :meth:`as_dict`.
+
+        Raises:
+            KeyError, TypeError: for a dict that lacks a field or holds another.
+        """
+        gaps = {k: tuple(d[k]) for k in ("light_stop_gaps_m", "crossing_stop_gaps_m")}
+        return cls(**{**d, **gaps})
+
 
 def free_road(real_gap_m: float, light_red_or_yellow: bool, light_gap_m: float,
               crossing_gap_m: float) -> bool:  # fmt: skip

@@ -107,14 +107,13 @@ def external_runs(plan: ReportPlan, files: Sequence[Path]) -> dict[str, tuple[St
             and traffic levels) or one named like another run.
     """
     taken = {run.name for run in plan.runs}
+    grid = sorted((lvl, seed) for lvl in plan.levels for seed in plan.seeds)
     out: dict[str, tuple[StoredRun, str]] = {}
     for path in files:
         for run in read_runs(path):
             if run.name in taken or run.name in out:
                 raise ValueError(f"{path}: run {run.name!r} has the name of another run")
-            cells = sorted((lvl, seed) for lvl, seed, _r in run.episodes)
-            grid = sorted((lvl, seed) for lvl in plan.levels for seed in plan.seeds)
-            if cells != grid:
+            if sorted((lvl, seed) for lvl, seed, _r in run.episodes) != grid:
                 raise ValueError(
                     f"{path}: run {run.name!r} is not on the report's grid (seeds "
                     f"{list(plan.seeds)} x levels {list(plan.levels)})"

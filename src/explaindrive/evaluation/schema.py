@@ -33,7 +33,6 @@ from pathlib import Path
 from typing import Any
 
 from explaindrive.env.metrics import EpisodeResult
-from explaindrive.env.ride_quality import RideQualityResult
 from explaindrive.evaluation.aggregate import aggregate, aggregate_by_level
 from explaindrive.evaluation.paper import paper_row
 from explaindrive.evaluation.runner import EpisodeRecord
@@ -153,8 +152,8 @@ def read_runs(path: Path) -> list[StoredRun]:
     for k, run in enumerate(doc.get("runs") or []):
         try:
             episodes = tuple(
-                (float(ep["traffic_level"]), int(ep["seed"]), _result(ep["metrics"]))
-                for ep in run["episodes"]
+                (float(e["traffic_level"]), int(e["seed"]), EpisodeResult.from_dict(e["metrics"]))
+                for e in run["episodes"]
             )
             runs.append(StoredRun(str(run["name"]), dict(run.get("policy") or {}), episodes))
         except (KeyError, TypeError, ValueError) as exc:
@@ -165,12 +164,3 @@ def read_runs(path: Path) -> list[StoredRun]:
     if not runs:
         raise ValueError(f"{path} holds no runs")
     return runs
-
-
-def _result(metrics: dict[str, Any]) -> EpisodeResult:
-    """An :class:`EpisodeResult` from its :meth:`~EpisodeResult.as_dict`."""
-    ride = dict(metrics["ride"])
-    for key in ("light_stop_gaps_m", "crossing_stop_gaps_m"):
-        ride[key] = tuple(ride[key])
-    fields = {**metrics, "stop_latencies": tuple(metrics["stop_latencies"])}
-    return EpisodeResult(**{**fields, "ride": RideQualityResult(**ride)})
