@@ -1,12 +1,14 @@
 """Print the steps that led to each violation of one episode of a bare network.
 
     python scripts/trace_violations.py src/explaindrive/agent/policies/fast.pt \
-        --seed 44 --traffic 0.75
+        --seed 44 --traffic 0.75 [--obs-noise 3,0.9]
 
 For every collision, red-light run or pedestrian-yield violation it prints the last
 ``--before`` steps: the time and the ego's route position, the observation, the
 network's speed change, and the actions that the learning mask (the shipped recipe's)
-and the run-time shield allow (one digit per action, -3 ... +3 m/s).
+and the run-time shield allow (one digit per action, -3 ... +3 m/s). With ``--obs-noise``
+the network sees a noisy observation, as ``explaindrive evaluate --obs-noise`` has it; each
+step then shows the true state on a second line.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from explaindrive.env.actions import speed_change
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.state import STATE_NAMES
 from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.env.noise import parse_noise
 from explaindrive.evaluation.parsing import parse_stop_schedule, stops_to_schedule
 
 VIOLATIONS = ("collision", "red_light_run", "ped_violation")
@@ -39,8 +42,10 @@ def main() -> None:
     parser.add_argument("--command", default=None, help="fast or comfort (default: the card's)")
     parser.add_argument("--stop-schedule", default=None, help="e.g. 60-75,150-165 [s]")
     parser.add_argument("--before", type=int, default=6, help="steps shown before each event")
+    parser.add_argument("--obs-noise", default="0,0", help="SD_M,SD_MPS on what the network sees")
     args = parser.parse_args()
 
+    noise = parse_noise(args.obs_noise)
     agent = QPolicy.load(args.policy)
     command = Command.parse(args.command or agent.card.get("mode", "fast"))
     driver = MergedController(agent, agent, command, use_shield=False)
@@ -50,9 +55,13 @@ def main() -> None:
         else ()
     )
     env = UrbanDriveEnv(
-        config=EnvConfig(traffic_level=args.traffic, yellow_leader=agent.yellow_leader)
+        config=EnvConfig(
+            traffic_level=args.traffic,
+            yellow_leader=agent.yellow_leader,
+            obs_noise=(noise.sd_m, noise.sd_mps),
+        )
     )
-    obs, _ = env.reset(
+    obs, info = env.reset(
         seed=args.seed,
         options={"command": command.label, "traffic_level": args.traffic,
                  "command_schedule": [list(item) for item in schedule]},
@@ -68,6 +77,8 @@ def main() -> None:
             cells += [f"{x:.1f}" for x in obs]
             cells += [f"{speed_change(action):+d}", _bits(training_mask(obs)),
                       _bits(runtime_mask(obs))]  # fmt: skip
+            if "true_obs" in info:
+                cells += ["\n  true\t", *(f"{x:.1f}" for x in info["true_obs"])]
             recent.append("\t".join(cells))
             obs, _, terminated, truncated, info = env.step(action)
             steps += 1
