@@ -4,9 +4,10 @@
         --comfort runs/r6-comfort/seed-0 runs/r6-comfort/seed-1 --out out/validation
 
 Every candidate (and the networks shipped today, unless ``--no-shipped``) is evaluated bare
-on the three validation grids: seeds 1000-1009 x the five traffic levels with the stops at
-60-75 and 150-165 s, without them, and without them under observation noise 2 m / 0.6 m/s;
-Krauss and IDM on the noise-free grid. Each evaluation is stored under ``--out`` in the
+on the four validation grids: seeds 1000-1009 x the five traffic levels with the stops at
+60-75 and 150-165 s, without them, and without them under observation noise of 2 m / 0.6
+m/s and of 3 m / 0.9 m/s; Krauss and IDM on the noise-free grid. Each evaluation is stored
+under ``--out`` (in a folder named after the policy file and its content's hash) in the
 format of ``explaindrive evaluate --json`` and reused when the script runs again. The stops
 grid of a run that ``train --seeds`` trained is read from its ``seeds.json``, which holds
 exactly that grid. Prints one table per policy, best first, and the pair to ship.
@@ -15,6 +16,7 @@ exactly that grid. Prints one table per policy, best first, and the pair to ship
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import re
 import sys
@@ -35,24 +37,33 @@ from explaindrive.evaluation.tables import fmt, markdown_table
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
 NOISE = (2.0, 0.6)  # [m, m/s] the noise grid's observation noise
+HEAVY_NOISE = (3.0, 0.9)  # [m, m/s] the heavy-noise grid's
 
 
 GRID_OPTIONS: dict[str, dict[str, Any]] = {
     "stops": {"stop_schedule": DEFAULT_EVAL_STOPS},
     "noise_free": {},
     "noise": {"obs_noise": NOISE},
+    "heavy_noise": {"obs_noise": HEAVY_NOISE},
 }
 """plan_run's options of each validation grid."""
 
 
-def slug(text: str) -> str:
-    """A file name for a candidate's path or name."""
-    return re.sub(r"[^A-Za-z0-9.-]+", "_", text.strip("/")) or "policy"
+def folder(policy: str) -> str:
+    """The folder name of a policy's evaluations: its name or path, and for a network the
+    start of its file's SHA-256, so that a shipped network replaced later is not mistaken
+    for the one evaluated before."""
+    name = re.sub(r"[^A-Za-z0-9.-]+", "_", policy.strip("/")) or "policy"
+    paths = parse_policy(policy, shield=False).paths
+    if not paths:
+        return name
+    digest = hashlib.sha256(Path(paths[0]).read_bytes()).hexdigest()[:12]
+    return f"{name}-{digest}"
 
 
 def evaluated(policy: str, grid: str, out: Path, workers: int) -> Aggregate:
     """The bare figures of ``policy`` on ``grid``, from ``out`` or evaluated and stored."""
-    path = out / slug(policy) / f"{grid}.json"
+    path = out / folder(policy) / f"{grid}.json"
     if not path.is_file():
         spec = parse_policy(policy, shield=False)
         seeds = parse_seeds(DEFAULT_EVAL_SEEDS)

@@ -43,9 +43,8 @@ def cand(
 ) -> Candidate:
     """A candidate clean on the stops and noise grids unless ``grids`` says otherwise."""
     clean = figures()
-    return Candidate(
-        name, mode, rule, {"stops": clean, "noise": clean, "noise_free": ride, **grids}
-    )
+    every = {"stops": clean, "noise": clean, "heavy_noise": clean, "noise_free": ride}
+    return Candidate(name, mode, rule, {**every, **grids})
 
 
 def test_shortfalls_are_relative_to_the_bound() -> None:
@@ -90,8 +89,10 @@ def test_violations_are_summed_over_the_grids() -> None:
     c = cand(
         "c", "fast", GOOD_FAST, stops=figures(speeding_steps=3),
         noise=figures(collision_episodes=1),
+        heavy_noise=figures(speeding_steps=20, red_light_runs=2),  # speeding not counted
     )  # fmt: skip
-    assert judge(c, KRAUSS, IDM).violations == 4
+    assert judge(c, KRAUSS, IDM).violations == 6
+    assert violations(a, speeding=False) == 11
 
 
 def test_rank_puts_violations_before_shortfall_before_objective() -> None:
@@ -122,8 +123,8 @@ def test_pair_shares_a_yellow_rule_and_has_the_smallest_total_shortfall() -> Non
 
 
 def test_a_candidate_needs_every_grid() -> None:
-    assert GRIDS == ("stops", "noise_free", "noise")
-    with pytest.raises(ValueError, match="noise"):
+    assert GRIDS == ("stops", "noise_free", "noise", "heavy_noise")
+    with pytest.raises(ValueError, match="noise, heavy_noise"):
         Candidate("c", "fast", "gentle", {"stops": figures(), "noise_free": figures()})
     with pytest.raises(ValueError, match="unknown mode"):
         Candidate("c", "stop", "gentle", {g: figures() for g in GRIDS})

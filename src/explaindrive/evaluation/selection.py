@@ -1,13 +1,16 @@
 """Which trained networks to ship: the project's rule, applied to validation figures.
 
-Each candidate is a trained network (bare, ``--no-shield``) with its figures on the three
+Each candidate is a trained network (bare, ``--no-shield``) with its figures on the four
 validation grids (:data:`GRIDS`): seeds 1000-1009 x the five traffic levels with the stops
 at 60-75 and 150-165 s, the same without stops, and the same with observation noise of
-2 m / 0.6 m/s. The validation seeds are disjoint from the evaluation seeds the README
-reports and from the training pool. A candidate comes before another by, in turn:
+2 m / 0.6 m/s and of 3 m / 0.9 m/s. The validation seeds are disjoint from the evaluation
+seeds the README reports and from the training pool. A candidate comes before another by,
+in turn:
 
 1. **violations**: fewer collisions, red-light runs, pedestrian-yield violations, speeding
-   steps and stops over their bound, summed over the three grids;
+   steps and stops over their bound, summed over the grids; under the heavier noise
+   speeding steps are not counted (a driver is asked not to speed up to 2 m / 0.6 m/s of
+   noise, and to stay clear of other road users and red lights under any noise);
 2. **shortfall**: a smaller sum of the relative shortfalls of the ride targets
    (:func:`targets`) on the noise-free grid, against SUMO's Krauss (fast) and IDM (comfort)
    on the same episodes; a met target counts 0, so a candidate is not paid for beating a
@@ -30,8 +33,10 @@ from dataclasses import dataclass
 
 from explaindrive.evaluation.aggregate import Aggregate
 
-GRIDS: tuple[str, ...] = ("stops", "noise_free", "noise")
+GRIDS: tuple[str, ...] = ("stops", "noise_free", "noise", "heavy_noise")
 """The validation grids a candidate is judged on; the ride targets use ``noise_free``."""
+SPEEDING_FREE_GRIDS: tuple[str, ...] = ("heavy_noise",)
+"""Grids whose speeding steps are not violations."""
 MODES: tuple[str, ...] = ("fast", "comfort")
 COMFORT_SPEED_SHARE = 0.95  # of IDM's mean speed
 SLOW_SHARE_MAX = 0.10  # of the free-road time below 60 % of the limit
@@ -77,12 +82,12 @@ def within(name: str, value: float | None, lo: float, hi: float) -> Target:
     return Target(name, value, f"{lo:g}-{hi:g}", _miss((lo - value) / lo, (value - hi) / hi))
 
 
-def violations(a: Aggregate) -> int:
-    """Collisions (episodes), red-light runs, pedestrian-yield violations, speeding steps
-    and stops over their bound."""
+def violations(a: Aggregate, speeding: bool = True) -> int:
+    """Collisions (episodes), red-light runs, pedestrian-yield violations, stops over their
+    bound and, unless ``speeding`` is false, speeding steps."""
     return (
-        a.collision_episodes + a.red_light_runs + a.ped_violations + a.speeding_steps
-        + a.stop_bound_misses
+        a.collision_episodes + a.red_light_runs + a.ped_violations + a.stop_bound_misses
+        + (a.speeding_steps if speeding else 0)
     )  # fmt: skip
 
 
@@ -164,7 +169,9 @@ class Judgement:
 
 def judge(candidate: Candidate, krauss: Aggregate, idm: Aggregate) -> Judgement:
     """Judge one candidate against the baselines' noise-free figures."""
-    total = sum(violations(candidate.grids[g]) for g in GRIDS)
+    total = sum(
+        violations(candidate.grids[g], speeding=g not in SPEEDING_FREE_GRIDS) for g in GRIDS
+    )
     found = targets(candidate.mode, candidate.grids["noise_free"], krauss, idm)
     return Judgement(candidate, total, tuple(found))
 
