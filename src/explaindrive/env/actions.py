@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -11,6 +13,7 @@ STEP_LENGTH_S = 1.0  # [s] decision step = SUMO step
 IDLE_ACTION = SPEED_CHANGES_MPS.index(0)
 MAX_BRAKE_MPS = -min(SPEED_CHANGES_MPS)  # [m/s per step] the strongest braking action
 STOP_MARGIN_M = 2.0  # [m] the gap a car braking hardest keeps before where it must stand
+SPEEDS_KEPT = 1024  # speeds whose results the one-speed helpers keep
 
 
 def speed_change(action: object) -> int:
@@ -71,8 +74,9 @@ def stopping_needs(v_new: NDArray[np.floating]) -> NDArray[np.float64]:
     return np.where(v > 0.0, v + braking_distances(v) + STOP_MARGIN_M, 0.0)
 
 
+@lru_cache(maxsize=SPEEDS_KEPT)
 def stopping_need(v_new: float) -> float:
-    """:func:`stopping_needs` of one speed."""
+    """:func:`stopping_needs` of one speed (kept per speed: an episode's speeds repeat)."""
     return float(stopping_needs(np.asarray(v_new)))
 
 
@@ -83,8 +87,10 @@ def least_stopping_needs(speed_mps: NDArray[np.floating]) -> NDArray[np.float64]
     return stopping_needs(np.maximum(v - MAX_BRAKE_MPS, 0.0))
 
 
+@lru_cache(maxsize=SPEEDS_KEPT)
 def least_stopping_need(speed_mps: float) -> float:
-    """:func:`least_stopping_needs` of one speed."""
+    """:func:`least_stopping_needs` of one speed (kept per speed: an episode's speeds
+    repeat)."""
     return float(least_stopping_needs(np.asarray(speed_mps)))
 
 

@@ -317,11 +317,17 @@ class RewardTerms:
     @property
     def total(self) -> float:
         """Sum of the terms."""
-        return math.fsum(getattr(self, f.name) for f in fields(self))
+        return math.fsum([getattr(self, name) for name in TERM_NAMES])
 
     def as_dict(self) -> dict[str, float]:
         """Terms plus ``total`` as a plain dict (for ``info``)."""
-        return {**{f.name: getattr(self, f.name) for f in fields(self)}, "total": self.total}
+        terms = {name: getattr(self, name) for name in TERM_NAMES}
+        terms["total"] = math.fsum(terms.values())
+        return terms
+
+
+TERM_NAMES: tuple[str, ...] = tuple(f.name for f in fields(RewardTerms))
+"""The names of the :class:`RewardTerms`, in their order."""
 
 
 def _signal_stop(w: RewardWeights, gap_m: float) -> float:

@@ -18,12 +18,16 @@ it. Under STOP both ask that every step brings the standstill one hardest-brakin
 closer.
 
 Every rule is written once, vectorised over a batch of raw observations
-(:func:`safe_action_mask`). The environment reports :func:`runtime_mask` of the true state
-as ``info["action_mask"]``; :mod:`explaindrive.agent.shield` builds the run-time shield on
-these rules.
+(:func:`safe_action_mask`); one observation runs the same rule on its components as numpy
+scalars, with what the actions do at its speed (:class:`ActionOutcomes`) kept per speed. The
+environment reports :func:`runtime_mask` of the true state as ``info["action_mask"]``;
+:mod:`explaindrive.agent.shield` builds the run-time shield on these rules.
 """
 
 from __future__ import annotations
+
+from functools import lru_cache
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,8 +37,10 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import (
     MAX_BRAKE_MPS,
     SPEED_CHANGES_MPS,
+    SPEEDS_KEPT,
     action_index,
     braking_distances,
+    least_stopping_needs,
     stopping_needs,
 )
 
@@ -48,6 +54,52 @@ def steps_to_stop(speed_mps: NDArray[np.floating] | float) -> NDArray[np.float64
     """Steps of hardest braking from ``speed_mps`` to a standstill: ceil(v / 3)."""
     v = np.maximum(np.asarray(speed_mps, dtype=np.float64), 0.0)
     return np.ceil(v / MAX_BRAKE_MPS - 1e-6)
+
+
+class ActionOutcomes(NamedTuple):
+    """What each of the 7 actions does to cars at given speeds: everything of the rule that
+    depends on the speed alone. Arrays of shape ``(B, 7)`` (``least_need``: ``(B, 1)``)
+    for speeds of shape ``(B, 1)``; of shape ``(7,)`` (``least_need``: 0-d) for one speed."""
+
+    v_new: NDArray[np.float64]
+    """The speed after the action."""
+    need: NDArray[np.float64]
+    """What standing still after it needs ahead (:func:`stopping_needs`)."""
+    least_need: NDArray[np.float64]
+    """What stopping from now on needs: the hardest braking's need (``stops_before``)."""
+    slows: NDArray[np.bool_]
+    """The action lowers the speed."""
+    keeps: NDArray[np.bool_]
+    """The action keeps the speed."""
+    closer: NDArray[np.bool_]
+    """After it the hardest braking needs a step fewer to a standstill, or none."""
+    eases: NDArray[np.bool_]
+    """It brakes less than the hardest braking."""
+
+
+def action_outcomes(speed_mps: NDArray[np.float64] | float) -> ActionOutcomes:
+    """The :class:`ActionOutcomes` of speeds of shape ``(B, 1)``, or of one speed."""
+    v = speed_mps
+    v_new = np.maximum(v + _CHANGES, 0.0)
+    return ActionOutcomes(
+        v_new=v_new,
+        need=stopping_needs(v_new),
+        least_need=least_stopping_needs(np.asarray(v)),
+        slows=v_new < v,
+        keeps=v_new == v,
+        closer=(steps_to_stop(v_new) < steps_to_stop(v)) | (v_new <= 0.0),
+        eases=v_new > v - MAX_BRAKE_MPS + 1e-9,
+    )
+
+
+@lru_cache(maxsize=SPEEDS_KEPT)
+def _outcomes_at(speed_mps: float) -> ActionOutcomes:
+    """:func:`action_outcomes` of one speed, kept (read-only): one observation's mask reads
+    it, and the speeds of an episode repeat."""
+    outcomes = action_outcomes(speed_mps)
+    for array in outcomes:
+        array.flags.writeable = False
+    return outcomes
 
 
 def safe_action_mask(
@@ -68,59 +120,71 @@ def safe_action_mask(
         false: then no action keeps a stopping option (see :func:`training_mask`).
     """
     x = np.asarray(obs, dtype=np.float64)
-    single = x.ndim == 1
-    x = x.reshape(-1, S.STATE_DIM)
-    v = x[:, S.V_EGO : S.V_EGO + 1]  # (B, 1)
-    v_new = np.maximum(v + _CHANGES, 0.0)  # (B, 7)
-    need = stopping_needs(v_new)
+    if x.ndim == 1:
+        # the components of one observation as numpy scalars: the same operations as on
+        # columns, without the cost of arrays
+        row = x.reshape(S.STATE_DIM)
+        outcomes = _outcomes_at(float(row[S.V_EGO]))
+        return ~_unsafe(tuple(row), outcomes, dilemma_braking, stop_progress)
+    rows = x.reshape(-1, S.STATE_DIM)
+    outcomes = action_outcomes(rows[:, S.V_EGO : S.V_EGO + 1])
+    return ~_unsafe(tuple(rows.T[:, :, None]), outcomes, dilemma_braking, stop_progress)
 
-    safe = _within_limit(x, v_new)
 
-    d_cross = x[:, S.D_CROSS : S.D_CROSS + 1]
-    safe &= ~((d_cross < S.SENSOR_RANGE_M) & (need > d_cross))
+def _unsafe(
+    columns: tuple[Any, ...], out: ActionOutcomes, dilemma_braking: bool, stop_progress: bool
+) -> NDArray[np.bool_]:
+    """The rule of :func:`safe_action_mask`: which actions are unsafe.
 
-    d_tl = x[:, S.D_TL : S.D_TL + 1]
-    tls = np.rint(x[:, S.TLS : S.TLS + 1])
-    light = (d_tl < S.SENSOR_RANGE_M) & (tls != 0)
-    # the hardest braking's need is what stopping from now on needs (``stops_before``)
-    must_go = light & (tls == 1) & ~(need[:, HARDEST_BRAKE : HARDEST_BRAKE + 1] <= d_tl)
-    safe &= ~(light & ~must_go & (need > d_tl))
+    Args:
+        columns: the 8 components of the observations, each of shape ``(B, 1)`` (or, for
+            one observation, each a numpy scalar).
+        out: the :class:`ActionOutcomes` of their speeds.
+        dilemma_braking, stop_progress: as in :func:`safe_action_mask`.
+    """
+    cmd, v, v_lim, gap, dv, d_tl, tls, d_cross = columns
+    need = out.need
+    unsafe = _over_limit(v_lim, out)
+    unsafe |= (d_cross < S.SENSOR_RANGE_M) & (need > d_cross)
+
+    tls = np.rint(tls)
+    signal = tls != 0
+    light = (d_tl < S.SENSOR_RANGE_M) & signal
+    must_go = light & (tls == 1) & ~(out.least_need <= d_tl)
+    unsafe |= light & ~must_go & (need > d_tl)
     if not dilemma_braking:
-        safe &= ~(must_go & (v_new < v))
+        unsafe |= must_go & out.slows
 
-    gap = x[:, S.D_LEAD : S.D_LEAD + 1]
-    virtual = ((tls != 0) & (np.abs(gap - d_tl) <= VIRTUAL_TOL_M)) | (
+    virtual = (signal & (np.abs(gap - d_tl) <= VIRTUAL_TOL_M)) | (
         np.abs(gap - d_cross) <= VIRTUAL_TOL_M
     )
     real = (gap < S.SENSOR_RANGE_M) & ~virtual
-    leader_v = np.maximum(v - x[:, S.DV : S.DV + 1], 0.0)
-    safe &= ~(real & (gap + braking_distances(leader_v, LEADER_BRAKE_MPS) < need))
+    leader_v = np.maximum(v - dv, 0.0)
+    unsafe |= real & (gap + braking_distances(leader_v, LEADER_BRAKE_MPS) < need)
 
     if stop_progress:
-        stopping = np.rint(x[:, S.CMD : S.CMD + 1]) == int(Command.STOP)
-        closer = (steps_to_stop(v_new) < steps_to_stop(v)) | (v_new <= 0.0)
-        clearing = must_go & (v_new == v)  # in the dilemma zone: clear the junction first
-        safe &= ~(stopping & ~closer & ~clearing)
-    return safe[0] if single else safe
+        stopping = np.rint(cmd) == int(Command.STOP)
+        clearing = must_go & out.keeps  # in the dilemma zone: clear the junction first
+        unsafe |= stopping & ~(out.closer | clearing)
+    return unsafe
 
 
-def _within_limit(
-    x: NDArray[np.float64], v_new: NDArray[np.float64] | None = None
-) -> NDArray[np.bool_]:
-    """Rows ``(B, 8)`` -> ``(B, 7)``: the actions that keep within the posted limit; above
-    it, only the hardest braking. ``v_new``: the speeds after each action, if computed."""
-    v = x[:, S.V_EGO : S.V_EGO + 1]
-    if v_new is None:
-        v_new = np.maximum(v + _CHANGES, 0.0)
-    return ~((v_new > x[:, S.V_LIM : S.V_LIM + 1]) & (v_new > v - MAX_BRAKE_MPS + 1e-9))
+def _over_limit(v_lim: Any, out: ActionOutcomes) -> NDArray[np.bool_]:
+    """The actions that exceed the posted limit ``v_lim`` (a column, or a scalar); above it,
+    all but the hardest braking. ``out``: the :class:`ActionOutcomes` of the speeds."""
+    return (out.v_new > v_lim) & out.eases
 
 
 def limit_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
     """The posted-limit rule of :func:`safe_action_mask` alone, for raw observations of shape
     ``(B, 8)`` (or ``(8,)``)."""
     x = np.asarray(obs, dtype=np.float64)
-    mask = _within_limit(x.reshape(-1, S.STATE_DIM))
-    return mask[0] if x.ndim == 1 else mask
+    if x.ndim == 1:
+        row = x.reshape(S.STATE_DIM)
+        return ~_over_limit(row[S.V_LIM], _outcomes_at(float(row[S.V_EGO])))
+    rows = x.reshape(-1, S.STATE_DIM)
+    outcomes = action_outcomes(rows[:, S.V_EGO : S.V_EGO + 1])
+    return ~_over_limit(rows[:, S.V_LIM : S.V_LIM + 1], outcomes)
 
 
 def _with_fallback(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
