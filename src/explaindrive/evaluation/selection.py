@@ -31,18 +31,19 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from explaindrive.env.reward import STOP_WINDOW_M
 from explaindrive.evaluation.aggregate import Aggregate
+from explaindrive.evaluation.spec import AGENTS
 
 GRIDS: tuple[str, ...] = ("stops", "noise_free", "noise", "heavy_noise")
 """The validation grids a candidate is judged on; the ride targets use ``noise_free``."""
 SPEEDING_FREE_GRIDS: tuple[str, ...] = ("heavy_noise",)
 """Grids whose speeding steps are not violations."""
-MODES: tuple[str, ...] = ("fast", "comfort")
+MODES: tuple[str, ...] = AGENTS
 COMFORT_SPEED_SHARE = 0.95  # of IDM's mean speed
 SLOW_SHARE_MAX = 0.10  # of the free-road time below 60 % of the limit
 HARD_BRAKES_MAX = 0.5  # per episode, outside STOP
 JERK_SHARE_MAX = 0.5  # of IDM's mean jerk
-STANDSTILL_WINDOW_M = (1.0, 5.0)  # before the stop line
 TOLERANCE = 1e-9  # a shortfall below this is rounding, not a miss
 
 
@@ -108,7 +109,7 @@ def targets(mode: str, a: Aggregate, krauss: Aggregate, idm: Aggregate) -> list[
             at_most("reversals", a.reversals_per_min or 0.0, krauss.reversals_per_min or 0.0),
         ]
     if mode == "comfort":
-        lo, hi = STANDSTILL_WINDOW_M
+        lo, hi = STOP_WINDOW_M
         return [
             at_least("mean speed", a.mean_speed_mps, COMFORT_SPEED_SHARE * idm.mean_speed_mps),
             at_most("slow free road", a.slow_free_road_share or 0.0, SLOW_SHARE_MAX),
