@@ -22,9 +22,9 @@ from explaindrive.agent.shield import runtime_mask, training_mask
 from explaindrive.commands import Command
 from explaindrive.env.actions import speed_change
 from explaindrive.env.config import EnvConfig
+from explaindrive.env.noise import parse_noise
 from explaindrive.env.state import STATE_NAMES
 from explaindrive.env.urban_drive import UrbanDriveEnv
-from explaindrive.env.noise import parse_noise
 from explaindrive.evaluation.parsing import parse_stop_schedule, stops_to_schedule
 
 VIOLATIONS = ("collision", "red_light_run", "ped_violation")
