@@ -119,16 +119,21 @@ def safe_action_mask(
         Boolean mask of shape ``(B, 7)`` (``(7,)`` for one observation). A row may be all
         false: then no action keeps a stopping option (see :func:`training_mask`).
     """
+    columns, outcomes = _columns(obs)
+    return ~_unsafe(columns, outcomes, dilemma_braking, stop_progress)
+
+
+def _columns(obs: NDArray[np.floating]) -> tuple[tuple[Any, ...], ActionOutcomes]:
+    """The 8 components of raw observations ``(B, 8)``, each a column ``(B, 1)``, and the
+    :class:`ActionOutcomes` of their speeds; for one observation ``(8,)``, the components as
+    numpy scalars (the same operations as on columns, without the cost of arrays) and its
+    speed's kept outcomes."""
     x = np.asarray(obs, dtype=np.float64)
     if x.ndim == 1:
-        # the components of one observation as numpy scalars: the same operations as on
-        # columns, without the cost of arrays
         row = x.reshape(S.STATE_DIM)
-        outcomes = _outcomes_at(float(row[S.V_EGO]))
-        return ~_unsafe(tuple(row), outcomes, dilemma_braking, stop_progress)
+        return tuple(row), _outcomes_at(float(row[S.V_EGO]))
     rows = x.reshape(-1, S.STATE_DIM)
-    outcomes = action_outcomes(rows[:, S.V_EGO : S.V_EGO + 1])
-    return ~_unsafe(tuple(rows.T[:, :, None]), outcomes, dilemma_braking, stop_progress)
+    return tuple(rows.T[:, :, None]), action_outcomes(rows[:, S.V_EGO : S.V_EGO + 1])
 
 
 def _unsafe(
@@ -178,13 +183,8 @@ def _over_limit(v_lim: Any, out: ActionOutcomes) -> NDArray[np.bool_]:
 def limit_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
     """The posted-limit rule of :func:`safe_action_mask` alone, for raw observations of shape
     ``(B, 8)`` (or ``(8,)``)."""
-    x = np.asarray(obs, dtype=np.float64)
-    if x.ndim == 1:
-        row = x.reshape(S.STATE_DIM)
-        return ~_over_limit(row[S.V_LIM], _outcomes_at(float(row[S.V_EGO])))
-    rows = x.reshape(-1, S.STATE_DIM)
-    outcomes = action_outcomes(rows[:, S.V_EGO : S.V_EGO + 1])
-    return ~_over_limit(rows[:, S.V_LIM : S.V_LIM + 1], outcomes)
+    columns, outcomes = _columns(obs)
+    return ~_over_limit(columns[S.V_LIM], outcomes)
 
 
 def _with_fallback(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
