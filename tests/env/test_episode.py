@@ -56,8 +56,9 @@ def test_the_info_reports_the_step() -> None:
     obs = np.array([0, 10, 13.89, 30, 4, 80, 2, 200], dtype=np.float32)
     crossings = CrossingReading(200.0, {})
     ep.seen = Percept(obs, None, None, None, crossings, LightState.RED)
-    terms = reward_terms(Command.FAST, rec.features(), RECIPES["paper"])
-    info = rec.info(ep, obs, 13.89, terms)
+    features = rec.features()
+    terms = reward_terms(Command.FAST, features, RECIPES["paper"]).as_dict()
+    info = rec.info(ep, obs, 13.89, features, terms)
     assert info["time_s"] == 4.0 and info["distance_m"] == 42.0
     assert info["real_ttc_s"] == pytest.approx(30.0 / 4.0)
     assert info["light_state"] == "red" and info["light_gap_m"] == 80.0
@@ -65,6 +66,6 @@ def test_the_info_reports_the_step() -> None:
     shown_green = obs.copy()
     shown_green[6] = 0
     ep.seen = Percept(shown_green, None, None, None, crossings, LightState.YELLOW)
-    assert rec.info(ep, shown_green, 13.89, terms)["light_state"] == "yellow"
+    assert rec.info(ep, shown_green, 13.89, features, terms)["light_state"] == "yellow"
     assert info["red_light_run"] and not info["ped_violation"] and not info["speeding"]
-    assert info["gap_m"] == math.inf and info["reward_terms"] == terms.as_dict()
+    assert info["gap_m"] == math.inf and info["reward_terms"] == terms

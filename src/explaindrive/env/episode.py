@@ -17,7 +17,6 @@ from explaindrive.env.noise import ObservationNoise
 from explaindrive.env.perception import Leader, Percept, Perception
 from explaindrive.env.reward import (
     STOP_REASON_GAP_M,
-    RewardTerms,
     StepFeatures,
     time_headway,
     time_to_collision,
@@ -108,13 +107,6 @@ class StepRecord:
     violations: Violations
     free_road: bool = False
 
-    @property
-    def ttc_s(self) -> float:
-        """TTC w.r.t. the effective leader (inf without one)."""
-        if self.leader is None:
-            return math.inf
-        return time_to_collision(self.leader.gap_m, self.motion.speed_mps - self.leader.speed_mps)
-
     def features(self) -> StepFeatures:
         """What the reward needs, w.r.t. the effective (real or virtual) leader."""
         leader, real, v = self.leader, self.real, self.motion.speed_mps
@@ -125,7 +117,7 @@ class StepRecord:
             speed_mps=v,
             speed_change_mps=self.change,
             limit_mps=self.limit_mps,
-            ttc_s=self.ttc_s,
+            ttc_s=time_to_collision(leader.gap_m, v - leader.speed_mps) if leader else math.inf,
             headway_s=time_headway(leader.gap_m, leader.length_m, v) if leader else math.inf,
             jerk_mps3=self.jerk,
             violation=self.violations.red_light_run or self.violations.ped_violation,
@@ -140,7 +132,12 @@ class StepRecord:
         )
 
     def info(
-        self, ep: Episode, obs: np.ndarray, legal_limit_mps: float, terms: RewardTerms
+        self,
+        ep: Episode,
+        obs: np.ndarray,
+        legal_limit_mps: float,
+        features: StepFeatures,
+        terms: dict[str, float],
     ) -> dict[str, Any]:
         """The step's ``info``: command, kinematics, leaders, safety events, reward terms.
 
@@ -148,9 +145,10 @@ class StepRecord:
             ep: the episode after the step.
             obs: the raw observation after the step.
             legal_limit_mps: the legal limit at the ego's position after the step.
-            terms: the step's reward terms.
+            features: the step's :meth:`features`.
+            terms: the step's reward terms (:meth:`RewardTerms.as_dict`).
         """
-        v, leader, real = self.motion.speed_mps, self.leader, self.real
+        v, real = self.motion.speed_mps, self.real
         return {
             "command": self.command.label,
             "next_command": ep.command.label,
@@ -161,13 +159,13 @@ class StepRecord:
             "jerk_mps3": self.jerk,
             "limit_mps": legal_limit_mps,
             "posted_limit_mps": self.limit_mps,
-            "gap_m": leader.gap_m if leader else math.inf,
-            "leader_virtual": bool(leader.virtual) if leader else False,
-            "ttc_s": self.ttc_s,
-            "headway_s": time_headway(leader.gap_m, leader.length_m, v) if leader else math.inf,
+            "gap_m": features.leader_gap_m,
+            "leader_virtual": features.leader_virtual,
+            "ttc_s": features.ttc_s,
+            "headway_s": features.headway_s,
             "real_gap_m": real.gap_m if real else math.inf,
             "real_ttc_s": time_to_collision(real.gap_m, v - real.speed_mps) if real else math.inf,
-            "real_headway_s": time_headway(real.gap_m, real.length_m, v) if real else math.inf,
+            "real_headway_s": features.real_headway_s,
             "real_leader_speed_mps": real.speed_mps if real else math.inf,
             "light_gap_m": float(obs[S.D_TL]),
             "light_state": ep.light_colour.label,
@@ -178,5 +176,5 @@ class StepRecord:
             "ped_violation": self.violations.ped_violation,
             "speeding": speeding(v, legal_limit_mps),
             "arrived": self.motion.arrived,
-            "reward_terms": terms.as_dict(),
+            "reward_terms": terms,
         }

@@ -36,7 +36,7 @@ from explaindrive.env.lights import AmberDecision
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.perception import LeaderSensor, Percept, Perception
 from explaindrive.env.render import TopDownView
-from explaindrive.env.reward import RECIPES, RewardTerms, reward_terms
+from explaindrive.env.reward import RECIPES, RewardTerms, StepFeatures, reward_terms
 from explaindrive.env.ride_quality import free_road
 from explaindrive.env.safety import runtime_mask
 from explaindrive.env.sumo_process import SUMO_DRIVES, EgoEntry, Motion, SumoProcess
@@ -239,16 +239,17 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
                 float(obs[S.D_TL]), float(obs[S.D_CROSS]),
             ),
         )  # fmt: skip
-        terms = self._reward(step)
+        features = step.features()
+        terms = self._reward(cmd, features).as_dict()
         terminated = self._is_terminated(motion)
         truncated = self._is_truncated(terminated)
         ep.done = terminated or truncated
         self._last_obs = obs
-        info = step.info(ep, obs, self.geometry.limit_at(ep.pos_m), terms)
+        info = step.info(ep, obs, self.geometry.limit_at(ep.pos_m), features, terms)
         info["action_mask"] = self.action_masks()
         if ep.noise.active:
             info["true_obs"] = obs.copy()
-        return self._output(obs), terms.total, terminated, truncated, info
+        return self._output(obs), terms["total"], terminated, truncated, info
 
     def render(self) -> NDArray[np.uint8] | None:
         """Under ``render_mode="rgb_array"``, the top-down view around the ego
@@ -273,9 +274,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._ep = None
 
     # ------------------------------------------------------------------ step pieces
-    def _reward(self, step: StepRecord) -> RewardTerms:
-        """The step's reward terms under the command the action was taken in."""
-        return reward_terms(step.command, step.features(), RECIPES[self.config.reward])
+    def _reward(self, command: Command, features: StepFeatures) -> RewardTerms:
+        """A step's reward terms under ``command``, the one its action was taken in."""
+        return reward_terms(command, features, RECIPES[self.config.reward])
 
     def _is_terminated(self, motion: Motion) -> bool:
         """The episode ends in a terminal state: the ego collided or reached its route's end."""
@@ -365,5 +366,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     def _output(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         """What the driver sees: the observation with the episode's sensor noise."""
         ep = self._ep
-        seen = ep.noise.apply(obs, ep.noise_rng) if ep is not None else obs.copy()
+        if ep is not None and ep.noise.active:
+            seen = ep.noise.apply(obs, ep.noise_rng)
+        else:
+            seen = obs.copy()
         return S.normalize(seen) if self.config.normalize_obs else seen

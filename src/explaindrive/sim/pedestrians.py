@@ -101,6 +101,8 @@ class KerbYield:
         for crossing in crossings:
             if not crossing.signalized and _blocks(crossing, front_m, length_m, reach_m):
                 wanted.update(_entering(api, crossing))
+        if not wanted and not self._held:
+            return
         person = api.person
         for pid in wanted.difference(self._held):
             self._held[pid] = float(person.getMaxSpeed(pid))
