@@ -52,6 +52,10 @@ class LightReading:
     light_id: str | None = None
 
 
+NO_LIGHT = LightReading()
+"""The reading with no light in sensor range."""
+
+
 @dataclass(frozen=True, slots=True)
 class CrossingReading:
     """The crossings ahead.
@@ -142,7 +146,7 @@ class LightSensor:
             if ahead < S.SENSOR_RANGE_M:
                 return LightReading(ahead, self.colour(api, light, lane_id), light.tls_id)
             break
-        return LightReading()
+        return NO_LIGHT
 
 
 class CrossingSensor:

@@ -189,6 +189,10 @@ def limit_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
 
 def _with_fallback(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
     """Rows that allow nothing allow the hardest braking (what the shield does there)."""
+    if mask.ndim == 1:  # one observation: a scalar test, cheaper than boolean indexing
+        if not np.count_nonzero(mask):
+            mask[HARDEST_BRAKE] = True
+        return mask
     rows = mask.reshape(-1, len(SPEED_CHANGES_MPS))
     rows[~rows.any(axis=1), HARDEST_BRAKE] = True
     return mask
