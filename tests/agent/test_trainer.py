@@ -245,3 +245,17 @@ def test_safe_learning_ends_the_run_once_episodes_run_clean(tmp_path: Path) -> N
     assert len(table) > 5 and all(clean(r) for r in table[-5:]) and not clean(table[-6])
     assert all(r["shielded"] == "0" for r in table)
     assert QPolicy.load(result.policy_path).card["stopped_early"] is True
+
+
+def test_prioritised_replay_trains_and_resumes_with_its_priorities(tmp_path: Path) -> None:
+    config = tiny(episodes=6, priority_alpha=0.6, priority_beta_steps=200)
+    result = train(config, tmp_path, env_factory=FACTORY)
+    assert (result.episodes, result.env_steps, result.updates) == (6, 120, 35)
+    replay = load_checkpoint(tmp_path / "checkpoints").replay
+    assert replay is not None
+    priorities = replay["priorities"]
+    assert priorities.shape == (120,) and np.all(priorities > 0.0)
+    # updated rows carry (|TD error| + eps)^0.6, the rest the largest priority so far
+    assert len(np.unique(priorities)) > 10
+    resumed = train(config.replace(episodes=10), tmp_path, env_factory=FACTORY, resume=True)
+    assert (resumed.episodes, resumed.env_steps, resumed.updates) == (10, 200, 75)

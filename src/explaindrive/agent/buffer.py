@@ -57,6 +57,10 @@ class ReplayBatch(NamedTuple):
     discount: NDArray[np.float32]
     mask: NDArray[np.bool_]
     next_mask: NDArray[np.bool_]
+    indices: NDArray[np.int64] | None = None
+    """The rows' slots in the buffer (prioritised replay, to update their priorities)."""
+    weights: NDArray[np.float32] | None = None
+    """Importance-sampling weights of the rows (prioritised replay); ``None``: all 1."""
 
 
 _FIELDS = ("obs", "next_obs", "actions", "rewards", "terminated", "discount", "mask", "next_mask")
@@ -120,6 +124,10 @@ class ReplayBuffer:
             target[idx] = True if value is None else np.asarray(value).reshape(n, N_ACTIONS)
         self.pos = int((self.pos + n) % self.capacity)
         self.size = min(self.size + n, self.capacity)
+        self._written(idx)
+
+    def _written(self, slots: NDArray[np.int64]) -> None:
+        """Hook for subclasses: transitions were just written to ``slots``."""
 
     def extend(self, transitions: Sequence[Transition]) -> None:
         """Append ``transitions`` in order (:meth:`add` on their columns)."""
@@ -144,7 +152,10 @@ class ReplayBuffer:
         """
         if self.size == 0:
             raise ValueError("cannot sample from an empty replay buffer")
-        idx = rng.integers(0, self.size, size=batch_size)
+        return self._rows(rng.integers(0, self.size, size=batch_size))
+
+    def _rows(self, idx: NDArray[np.integer]) -> ReplayBatch:
+        """The transitions in slots ``idx``."""
         return ReplayBatch(
             obs=self.obs[idx],
             actions=self.actions[idx].astype(np.int64),

@@ -113,6 +113,15 @@ class TrainConfig(ConfigModel, ScenarioFields):
     """Transitions after which epsilon is ``eps_final``."""
     n_step: PositiveInt = 1
     """Steps summed in each bootstrapped return (1: the paper's one-step target)."""
+    priority_alpha: Fraction = 0.0
+    """Prioritised replay (:mod:`explaindrive.agent.prioritized`): transitions are sampled in
+    proportion to their priority (absolute TD error) to this power; 0 samples uniformly
+    (the paper)."""
+    priority_beta: Fraction = 0.4
+    """Importance-sampling exponent at the start of prioritised replay, annealed linearly to
+    1 over ``priority_beta_steps`` transitions."""
+    priority_beta_steps: PositiveInt = 400_000
+    """Transitions over which ``priority_beta`` rises to 1."""
 
     traffic_levels: Annotated[tuple[TrafficLevel, ...], FROM_LIST, Field(min_length=1)] = (
         TRAFFIC_LEVELS

@@ -33,6 +33,8 @@ class UpdateStats:
     learning_rate: float
     grad_norm: float
     """Before clipping; 0 when clipping is off."""
+    abs_td_errors: np.ndarray | None = None
+    """|target - Q| of each row (prioritised replay's new priorities); ``None`` without it."""
 
 
 class D3QNLearner:
@@ -66,6 +68,12 @@ class D3QNLearner:
         if c.lr_final is None:
             return c.lr
         return linear_schedule(c.lr, c.lr_final, c.lr_decay_steps, env_steps)
+
+    def priority_beta(self, env_steps: int) -> float:
+        """Importance-sampling exponent of prioritised replay after ``env_steps``
+        transitions: linear from ``priority_beta`` to 1 over ``priority_beta_steps``."""
+        c = self.config
+        return linear_schedule(c.priority_beta, 1.0, c.priority_beta_steps, env_steps)
 
     @torch.no_grad()
     def q_values(self, obs: np.ndarray) -> np.ndarray:
@@ -128,7 +136,8 @@ class D3QNLearner:
             rewards, terminated, next_online, next_target, discount, next_mask
         )
         q_taken = q_obs.gather(1, actions.unsqueeze(1)).squeeze(1)
-        loss = td = td_loss(q_taken, target, c.loss, c.huber_delta)
+        weights = None if batch.weights is None else torch.from_numpy(batch.weights)
+        loss = td = td_loss(q_taken, target, c.loss, c.huber_delta, weights)
         unsafe = torch.zeros(())
         if c.safe_learning:
             mask = torch.from_numpy(batch.mask)
@@ -152,6 +161,7 @@ class D3QNLearner:
             q_values=float(q_taken.detach().mean()),
             learning_rate=lr,
             grad_norm=grad_norm,
+            abs_td_errors=(None if weights is None else (target - q_taken.detach()).abs().numpy()),
         )
 
     @torch.no_grad()

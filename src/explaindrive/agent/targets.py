@@ -104,17 +104,26 @@ def unsafe_action_loss(
     return per_action.sum(dim=-1).mean()
 
 
-def td_loss(q_taken: Tensor, target: Tensor, kind: str = "mse", huber_delta: float = 1.0) -> Tensor:
-    """Mean TD loss between the Q-values of the taken actions and their targets.
+def td_loss(
+    q_taken: Tensor,
+    target: Tensor,
+    kind: str = "mse",
+    huber_delta: float = 1.0,
+    weights: Tensor | None = None,
+) -> Tensor:
+    """Mean TD loss between the Q-values of the taken actions and their targets; with
+    ``weights`` (importance-sampling weights of prioritised replay), the weighted mean.
 
     Raises:
         ValueError: if ``kind`` is neither ``mse`` nor ``huber``.
     """
     if kind == "mse":
-        return F.mse_loss(q_taken, target)
-    if kind == "huber":
-        return F.huber_loss(q_taken, target, delta=huber_delta)
-    raise ValueError(f"unknown TD loss {kind!r}; expected 'mse' or 'huber'")
+        per_row = F.mse_loss(q_taken, target, reduction="none")
+    elif kind == "huber":
+        per_row = F.huber_loss(q_taken, target, delta=huber_delta, reduction="none")
+    else:
+        raise ValueError(f"unknown TD loss {kind!r}; expected 'mse' or 'huber'")
+    return per_row.mean() if weights is None else (weights * per_row).mean()
 
 
 def linear_schedule(start: float, end: float, duration: int, t: int) -> float:

@@ -52,6 +52,7 @@ from explaindrive.agent.checkpoint import (
 from explaindrive.agent.config import TrainConfig
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.pool import WorkerLost, WorkerPool
+from explaindrive.agent.prioritized import PrioritizedReplayBuffer
 from explaindrive.agent.rollout import CollectRequest, EnvFactory, Rollout, default_env_factory
 from explaindrive.agent.run_log import RunLog, git_commit, note, plot_training_curve, truncate_csv
 from explaindrive.agent.run_state import RunState
@@ -117,7 +118,11 @@ class Trainer:
         torch.set_num_threads(config.torch_threads)
 
         self.learner = D3QNLearner(config)
-        self.buffer = ReplayBuffer(config.buffer_size)
+        self.buffer = (
+            PrioritizedReplayBuffer(config.buffer_size, config.priority_alpha)
+            if config.priority_alpha > 0.0
+            else ReplayBuffer(config.buffer_size)
+        )
         self.state = RunState.start(config.seed, config.moving_average_window, git_commit())
         self.resumed = resume  # else episodes.csv starts afresh: no rows counted twice
         if resume:
@@ -283,7 +288,14 @@ class Trainer:
         c, s = self.config, self.state
         while s.update_debt >= 1.0 and len(self.buffer) >= c.batch_size:
             s.update_debt -= 1.0
-            stats = self.learner.update(self.buffer.sample(c.batch_size, s.rng), s.env_steps)
+            buffer = self.buffer
+            if isinstance(buffer, PrioritizedReplayBuffer):
+                batch = buffer.sample(c.batch_size, s.rng, self.learner.priority_beta(s.env_steps))
+                stats = self.learner.update(batch, s.env_steps)
+                assert batch.indices is not None and stats.abs_td_errors is not None
+                buffer.update_priorities(batch.indices, stats.abs_td_errors)
+            else:
+                stats = self.learner.update(buffer.sample(c.batch_size, s.rng), s.env_steps)
             if self.learner.updates % c.log_every_updates == 0:
                 out.losses(stats, s.env_steps)
 
