@@ -259,3 +259,14 @@ def test_prioritised_replay_trains_and_resumes_with_its_priorities(tmp_path: Pat
     assert len(np.unique(priorities)) > 10
     resumed = train(config.replace(episodes=10), tmp_path, env_factory=FACTORY, resume=True)
     assert (resumed.episodes, resumed.env_steps, resumed.updates) == (10, 200, 75)
+
+
+def test_boundary_states_join_the_updates(tmp_path: Path) -> None:
+    result = train(tiny(episodes=4, boundary_weight=1.0), tmp_path, env_factory=FACTORY)
+    assert (result.episodes, result.updates) == (4, 15)
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    events = EventAccumulator(str(tmp_path / "tb"))
+    events.Reload()
+    losses = [e.value for e in events.Scalars("losses/boundary_loss")]
+    assert len(losses) == 1 and losses[0] >= 0.0  # logged at update 10

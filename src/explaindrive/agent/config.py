@@ -166,6 +166,10 @@ class TrainConfig(ConfigModel, ScenarioFields):
     the safety masks of learning are computed on the true state."""
     noisy_share: Fraction = 0.5
     """Share of the episodes with observation noise (when ``obs_noise_max`` is not zero)."""
+    boundary_weight: NonNegativeFloat = 0.0
+    """Weight of the unsafe-action loss on one synthetic observation per minibatch row, moved
+    near the safety boundary (:mod:`explaindrive.agent.boundary`; ``safe_learning``); 0
+    turns it off."""
     dilemma_braking: bool = True
     """Whether the safety mask of learning leaves braking in a yellow light's dilemma zone
     (where even the hardest braking cannot stop before the line) to the rewards; ``False``

@@ -33,6 +33,8 @@ class UpdateStats:
     learning_rate: float
     grad_norm: float
     """Before clipping; 0 when clipping is off."""
+    boundary_loss: float = 0.0
+    """The unsafe-action loss on synthetic boundary observations (0 without them)."""
     abs_td_errors: np.ndarray | None = None
     """|target - Q| of each row (prioritised replay's new priorities); ``None`` without it."""
 
@@ -110,11 +112,19 @@ class D3QNLearner:
         """Epsilon-greedy actions for a batch of raw observations, in one forward pass."""
         return self.explore(self.q_values(obs), epsilon, rng, mask)
 
-    def update(self, batch: ReplayBatch, env_steps: int) -> UpdateStats:
+    def update(
+        self,
+        batch: ReplayBatch,
+        env_steps: int,
+        boundary: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> UpdateStats:
         """One gradient step on a minibatch; updates the target network when due.
 
         With ``safe_learning`` the double-DQN argmax runs over the safe actions of the next
-        state and the unsafe actions of the state are pushed down to ``unsafe_q``.
+        state and the unsafe actions of the state are pushed down to ``unsafe_q``; with
+        ``boundary`` (synthetic observations and their masks,
+        :mod:`explaindrive.agent.boundary`) the unsafe actions of those are pushed down
+        too, weighted by ``boundary_weight``.
         """
         c = self.config
         lr = self.learning_rate(env_steps)
@@ -126,8 +136,10 @@ class D3QNLearner:
         rewards = torch.from_numpy(batch.rewards)
         terminated = torch.from_numpy(batch.terminated)
 
-        q_both = self.q(torch.cat([obs, next_obs]))  # one forward pass for s and s'
-        q_obs, next_online = q_both[: len(obs)], q_both[len(obs) :].detach()
+        extra = [torch.from_numpy(boundary[0])] if boundary is not None else []
+        q_all = self.q(torch.cat([obs, next_obs, *extra]))  # one forward pass for all
+        n = len(obs)
+        q_obs, next_online = q_all[:n], q_all[n : 2 * n].detach()
         with torch.no_grad():
             next_target = self.q_target(next_obs)
         discount = torch.from_numpy(batch.discount)
@@ -138,13 +150,19 @@ class D3QNLearner:
         q_taken = q_obs.gather(1, actions.unsqueeze(1)).squeeze(1)
         weights = None if batch.weights is None else torch.from_numpy(batch.weights)
         loss = td = td_loss(q_taken, target, c.loss, c.huber_delta, weights)
-        unsafe = torch.zeros(())
+        unsafe = on_boundary = torch.zeros(())
         if c.safe_learning:
             mask = torch.from_numpy(batch.mask)
             unsafe = unsafe_action_loss(
                 q_obs, mask, c.unsafe_q, c.loss, c.huber_delta, c.unsafe_margin
             )
             loss = td + c.unsafe_loss_weight * unsafe
+            if boundary is not None:
+                on_boundary = unsafe_action_loss(
+                    q_all[2 * n :], torch.from_numpy(boundary[1]), c.unsafe_q, c.loss,
+                    c.huber_delta, c.unsafe_margin,
+                )  # fmt: skip
+                loss = loss + c.boundary_weight * on_boundary
 
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
@@ -158,6 +176,7 @@ class D3QNLearner:
         return UpdateStats(
             td_loss=float(td.detach()),
             unsafe_loss=float(unsafe.detach()),
+            boundary_loss=float(on_boundary.detach()),
             q_values=float(q_taken.detach().mean()),
             learning_rate=lr,
             grad_norm=grad_norm,

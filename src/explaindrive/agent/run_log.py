@@ -237,6 +237,8 @@ class RunLog:
         self.tb.add_scalar("charts/learning_rate", stats.learning_rate, step)
         if c.safe_learning:
             self.tb.add_scalar("losses/unsafe_loss", stats.unsafe_loss, step)
+            if c.boundary_weight > 0.0:
+                self.tb.add_scalar("losses/boundary_loss", stats.boundary_loss, step)
         if c.grad_clip_norm is not None:
             self.tb.add_scalar("losses/grad_norm", stats.grad_norm, step)
 

@@ -39,6 +39,7 @@ from typing import Any
 
 import torch
 
+from explaindrive.agent.boundary import boundary_batch
 from explaindrive.agent.buffer import ReplayBuffer
 from explaindrive.agent.checkpoint import (
     CHECKPOINT_FILE,
@@ -291,11 +292,15 @@ class Trainer:
             buffer = self.buffer
             if isinstance(buffer, PrioritizedReplayBuffer):
                 batch = buffer.sample(c.batch_size, s.rng, self.learner.priority_beta(s.env_steps))
-                stats = self.learner.update(batch, s.env_steps)
+            else:
+                batch = buffer.sample(c.batch_size, s.rng)
+            boundary = None
+            if c.safe_learning and c.boundary_weight > 0.0:
+                boundary = boundary_batch(batch.obs, s.rng, c.dilemma_braking)
+            stats = self.learner.update(batch, s.env_steps, boundary)
+            if isinstance(buffer, PrioritizedReplayBuffer):
                 assert batch.indices is not None and stats.abs_td_errors is not None
                 buffer.update_priorities(batch.indices, stats.abs_td_errors)
-            else:
-                stats = self.learner.update(buffer.sample(c.batch_size, s.rng), s.env_steps)
             if self.learner.updates % c.log_every_updates == 0:
                 out.losses(stats, s.env_steps)
 

@@ -1,0 +1,96 @@
+"""Synthetic boundary observations: where they land and what their masks say."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from explaindrive.agent.boundary import BOUNDARY_SPAN, boundary_batch, boundary_observations
+from explaindrive.agent.buffer import ReplayBatch
+from explaindrive.agent.config import PASSENGER
+from explaindrive.agent.learner import D3QNLearner
+from explaindrive.agent.shield import training_mask
+from explaindrive.env import state as S
+from explaindrive.env.actions import stopping_needs
+
+R = S.SENSOR_RANGE_M
+# cmd, v, v_lim, gap, dv, d_tl, tls, d_cross
+FOLLOWING = [1.0, 10.0, 13.89, 40.0, 4.0, R, 0.0, R]  # a leader at 6 m/s, 40 m ahead
+RED_AHEAD = [1.0, 8.0, 13.89, 60.0, 8.0, 60.0, 2.0, 90.0]  # a red line as leader, a crossing
+EMPTY = [0.0, 12.0, 13.89, R, 0.0, R, 0.0, R]
+
+
+def _synthetic(rows: list[list[float]], n: int = 4000, seed: int = 0) -> np.ndarray:
+    obs = np.repeat(np.asarray(rows, dtype=np.float32), n, axis=0)
+    return boundary_observations(obs, np.random.default_rng(seed))
+
+
+def test_speed_moves_by_whole_steps_and_the_leader_keeps_its_speed() -> None:
+    x = _synthetic([FOLLOWING])
+    assert set(np.unique(x[:, S.V_EGO]).tolist()) == {8.0, 9.0, 10.0, 11.0, 12.0}
+    assert np.allclose(x[:, S.V_EGO] - x[:, S.DV], 6.0)  # leader speed v - dv stays 6 m/s
+    assert np.allclose(x[:, [S.CMD, S.V_LIM, S.D_TL, S.TLS, S.D_CROSS]], [1.0, 13.89, R, 0.0, R])
+
+
+def test_the_nearest_object_lands_near_the_stopping_need() -> None:
+    x = _synthetic([FOLLOWING])
+    limit = BOUNDARY_SPAN * (stopping_needs(x[:, S.V_EGO].astype(np.float64) + 3.0) + 1.0)
+    assert np.all(x[:, S.D_LEAD] <= limit + 1e-4) and np.all(x[:, S.D_LEAD] >= 0.0)
+    # uniform over [0, limit]: about half below half the limit
+    assert np.mean(x[:, S.D_LEAD] < limit / 2) == pytest.approx(0.5, abs=0.03)
+
+
+def test_distances_scale_together_so_the_line_stays_the_leader() -> None:
+    x = _synthetic([RED_AHEAD])
+    assert np.allclose(x[:, S.D_LEAD], x[:, S.D_TL])
+    assert np.allclose(x[:, S.D_CROSS], np.minimum(1.5 * x[:, S.D_TL], R - 1.0), rtol=1e-5)
+    close = _synthetic([[1.0, 8.0, 13.89, 2.0, 2.0, R, 0.0, 150.0]])  # leader 2 m, crossing
+    assert close[:, S.D_CROSS].max() == R - 1.0  # scaled up past the range: kept inside it
+    assert np.allclose(x[:, S.DV], x[:, S.V_EGO])  # the line stands still
+    assert np.all(x[:, S.TLS] == 2.0)
+
+
+def test_an_empty_road_gets_a_red_light_half_of_the_time() -> None:
+    x = _synthetic([EMPTY])
+    red = x[:, S.TLS] == 2.0
+    assert red.mean() == pytest.approx(0.5, abs=0.03)
+    assert np.allclose(x[red, S.D_LEAD], x[red, S.D_TL]) and np.allclose(
+        x[red, S.DV], x[red, S.V_EGO]
+    )
+    assert np.all(x[~red][:, [S.D_LEAD, S.DV, S.D_TL, S.D_CROSS]] == [R, 0.0, R, R])
+
+
+def test_the_masks_are_the_rules_and_many_rows_sit_on_the_boundary() -> None:
+    obs = np.asarray([FOLLOWING, RED_AHEAD, EMPTY] * 500, dtype=np.float32)
+    synthetic, mask = boundary_batch(obs, np.random.default_rng(3), dilemma_braking=True)
+    assert np.array_equal(mask, training_mask(synthetic, True))
+    # a worked row: 3 m/s, a red line 1.9 m ahead (the light a network ran easing off by
+    # 1 m/s per step): only the hardest braking is safe
+    row = np.asarray([1.0, 3.0, 13.89, 1.9, 3.0, 1.9, 2.0, R], dtype=np.float32)
+    assert training_mask(row, True).tolist() == [True] + [False] * 6
+    # the original rows forbid no braking or keeping; the synthetic ones straddle every
+    # action's boundary: the stronger the action, the more rows forbid it
+    assert not (~training_mask(obs, True))[:, :4].any()
+    unsafe_share = (~mask).mean(axis=0)
+    assert unsafe_share[0] == 0.0 and np.all(np.diff(unsafe_share[1:]) > 0.05)
+    assert unsafe_share[1] > 0.15 and unsafe_share[6] < 0.95
+
+
+def test_boundary_loss_pushes_the_unsafe_actions_of_synthetic_rows_down() -> None:
+    config = PASSENGER.replace(boundary_weight=1.0, lr=1e-2, lr_final=None)
+    learner = D3QNLearner(config)
+    row = np.asarray([[1.0, 3.0, 13.89, 1.9, 3.0, 1.9, 2.0, R]], dtype=np.float32)
+    mask = training_mask(row, True)
+    batch = ReplayBatch(
+        obs=row, actions=np.array([0]), rewards=np.zeros(1, np.float32), next_obs=row,
+        terminated=np.ones(1, bool), discount=np.ones(1, np.float32),
+        mask=np.ones((1, 7), bool), next_mask=np.ones((1, 7), bool),
+    )  # fmt: skip
+    for _ in range(200):
+        stats = learner.update(batch, 0, (row, mask))
+    q = learner.q_values(row)[0]
+    assert int(np.argmax(q)) == 0  # only the boundary loss says so: the stored mask is all-safe
+    assert stats.boundary_loss < 1.0
+    with torch.no_grad():
+        assert float(learner.q(torch.from_numpy(row))[0, 0]) == pytest.approx(q[0])
