@@ -254,7 +254,9 @@ def _train_seeds(
         print_error(exc)
         raise typer.Exit(2) from None
     out = out or Path("runs") / f"{mode}-seeds"
-    console.print(f"training {mode} with seeds {', '.join(map(str, seeds))} side by side -> {out}")
+    listed = ", ".join(map(str, seeds))
+    which = f"seeds {listed} side by side" if len(seeds) > 1 else f"seed {listed}"
+    console.print(f"training {mode} with {which} -> {out}")
     codes = train_seeds(train_args, seeds, out)
     for s, code in codes.items():
         status = "done" if code == 0 else f"failed (exit {code}, see {out}/seed-{s}.log)"
