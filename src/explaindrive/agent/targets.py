@@ -93,15 +93,21 @@ def unsafe_action_loss(
         best_safe = q_values.detach().masked_fill(~mask, -torch.inf).max(dim=-1, keepdim=True)
         floor = torch.where(torch.isfinite(best_safe.values), best_safe.values - margin, floor)
     excess = (q_values - floor).clamp(min=0.0) * (~mask).to(q_values.dtype)
-    if kind == "mse":
-        per_action = excess.square()
-    elif kind == "huber":
-        per_action = F.huber_loss(
-            excess, torch.zeros_like(excess), delta=huber_delta, reduction="none"
-        )
-    else:
-        raise ValueError(f"unknown loss {kind!r}; expected 'mse' or 'huber'")
+    per_action = _elementwise(excess, torch.zeros_like(excess), kind, huber_delta, "loss")
     return per_action.sum(dim=-1).mean()
+
+
+def _elementwise(pred: Tensor, target: Tensor, kind: str, huber_delta: float, name: str) -> Tensor:
+    """The ``mse`` or ``huber`` loss of each element (``name`` labels the error).
+
+    Raises:
+        ValueError: if ``kind`` is neither ``mse`` nor ``huber``.
+    """
+    if kind == "mse":
+        return F.mse_loss(pred, target, reduction="none")
+    if kind == "huber":
+        return F.huber_loss(pred, target, delta=huber_delta, reduction="none")
+    raise ValueError(f"unknown {name} {kind!r}; expected 'mse' or 'huber'")
 
 
 def td_loss(
@@ -117,12 +123,7 @@ def td_loss(
     Raises:
         ValueError: if ``kind`` is neither ``mse`` nor ``huber``.
     """
-    if kind == "mse":
-        per_row = F.mse_loss(q_taken, target, reduction="none")
-    elif kind == "huber":
-        per_row = F.huber_loss(q_taken, target, delta=huber_delta, reduction="none")
-    else:
-        raise ValueError(f"unknown TD loss {kind!r}; expected 'mse' or 'huber'")
+    per_row = _elementwise(q_taken, target, kind, huber_delta, "TD loss")
     return per_row.mean() if weights is None else (weights * per_row).mean()
 
 
