@@ -94,3 +94,27 @@ def test_boundary_loss_pushes_the_unsafe_actions_of_synthetic_rows_down() -> Non
     assert stats.boundary_loss < 1.0
     with torch.no_grad():
         assert float(learner.q(torch.from_numpy(row))[0, 0]) == pytest.approx(q[0])
+
+
+
+@pytest.mark.parametrize("boundary_margin", [None, 5.0])
+def test_the_boundary_rows_have_their_own_margin(boundary_margin: float | None) -> None:
+    # A row 3 m before a red line at 13.89 m/s: only -3 is safe. The loss on it is the mean
+    # squared excess of the six unsafe values over (best safe - margin), computed by hand
+    # from the values before the update; the margin is unsafe_margin (30) unless set.
+    config = PASSENGER.replace(boundary_weight=1.0, boundary_margin=boundary_margin, loss="mse")
+    learner = D3QNLearner(config)
+    row = np.asarray([[1.0, 3.0, 13.89, 1.9, 3.0, 1.9, 2.0, R]], dtype=np.float32)
+    mask = training_mask(row, True)
+    assert mask[0].tolist() == [True] + [False] * 6
+    q = learner.q_values(row)[0].astype(np.float64)
+    margin = 30.0 if boundary_margin is None else boundary_margin
+    expected = float(np.sum(np.maximum(q[1:] - (q[0] - margin), 0.0) ** 2))
+    batch = ReplayBatch(
+        obs=row, actions=np.array([0]), rewards=np.zeros(1, np.float32), next_obs=row,
+        terminated=np.ones(1, bool), discount=np.ones(1, np.float32),
+        mask=np.ones((1, 7), bool), next_mask=np.ones((1, 7), bool),
+    )  # fmt: skip
+    stats = learner.update(batch, 0, (row, mask))
+    assert stats.boundary_loss == pytest.approx(expected, rel=1e-4)
+    assert expected > 6 * (margin - 1.0) ** 2  # the fresh network's values are near zero

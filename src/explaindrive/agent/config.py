@@ -170,6 +170,11 @@ class TrainConfig(ConfigModel, ScenarioFields):
     """Weight of the unsafe-action loss on one synthetic observation per minibatch row, moved
     near the safety boundary (:mod:`explaindrive.agent.boundary`; ``safe_learning``); 0
     turns it off."""
+    boundary_margin: PositiveFloat | None = None
+    """How far below the best safe action the unsafe actions of those synthetic rows are
+    pushed; ``None`` uses ``unsafe_margin``. A smaller margin orders the actions of states
+    near the boundary without pulling down the same actions in the safe states around
+    them."""
     dilemma_braking: bool = True
     """Whether the safety mask of learning leaves braking in a yellow light's dilemma zone
     (where even the hardest braking cannot stop before the line) to the rewards; ``False``

@@ -160,7 +160,8 @@ class D3QNLearner:
             if boundary is not None:
                 on_boundary = unsafe_action_loss(
                     q_all[2 * n :], torch.from_numpy(boundary[1]), c.unsafe_q, c.loss,
-                    c.huber_delta, c.unsafe_margin,
+                    c.huber_delta,
+                    c.unsafe_margin if c.boundary_margin is None else c.boundary_margin,
                 )  # fmt: skip
                 loss = loss + c.boundary_weight * on_boundary
 
