@@ -96,7 +96,6 @@ def test_boundary_loss_pushes_the_unsafe_actions_of_synthetic_rows_down() -> Non
         assert float(learner.q(torch.from_numpy(row))[0, 0]) == pytest.approx(q[0])
 
 
-
 @pytest.mark.parametrize("boundary_margin", [None, 5.0])
 def test_the_boundary_rows_have_their_own_margin(boundary_margin: float | None) -> None:
     # A row 3 m before a red line at 13.89 m/s: only -3 is safe. The loss on it is the mean
