@@ -1,0 +1,98 @@
+"""Where a network settles on a free road and before a red light, probed without SUMO.
+
+    python scripts/probe_policy.py src/explaindrive/agent/policies/fast.pt \
+        src/explaindrive/agent/policies/comfort.pt [--noise-free-only]
+
+Both probes follow the network's greedy (bare) choice on made-up states, with the
+environment's kinematics: the speed change applies at once and the car covers its new
+speed in the 1 s step.
+
+- Free road, per posted limit: from a standstill with nothing in range, the speed where the
+  network stops accelerating, its share of the limit, the highest whole speed under the
+  limit, and how far Q(+1) lies below the best action at the settled speed.
+- Red light: from that settled speed, with a red light ``--light-m`` ahead as the leader,
+  the approach until the car stands: the distance it stands from the line, its hardest
+  braking and how far from the line it starts braking.
+
+A network trained with observation noise settles below what the noise-free state would
+allow; these probes show by how much, state by state, where the evaluation's averages
+(free-road speed share, standstill distance) only show the result.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import numpy as np
+
+from explaindrive.agent.controller import QPolicy
+from explaindrive.env import state as S
+from explaindrive.commands import Command
+from explaindrive.env.actions import action_index, speed_change
+
+LIMITS_KMH = (30, 40, 50, 60, 70)
+
+
+def _obs(cmd: int, v: float, limit: float, light_m: float | None) -> np.ndarray:
+    d = S.SENSOR_RANGE_M if light_m is None else light_m
+    tls = S.LightState.GREEN if light_m is None else S.LightState.RED
+    dv = 0.0 if light_m is None else v
+    return np.asarray([cmd, v, limit, d, dv, d, float(tls), S.SENSOR_RANGE_M], np.float32)
+
+
+def free_road(policy: QPolicy, cmd: int, limit: float) -> tuple[float, float]:
+    """The speed the network settles at from a standstill, and Q(+1) - max Q there."""
+    v = 0.0
+    for _ in range(40):
+        q = policy.q_values(_obs(cmd, v, limit, None))
+        change = speed_change(int(np.argmax(q)))
+        if change <= 0:
+            return v, float(q[action_index(1)] - q.max())
+        v = min(v + change, S.MAX_SPEED_MPS)
+    return v, math.nan
+
+
+def red_light(
+    policy: QPolicy, cmd: int, limit: float, speed: float, light_m: float
+) -> tuple[float, int, float]:
+    """From ``speed``, ``light_m`` before a red line: the distance the car stands from it,
+    its hardest braking [m/s per step] and how far from the line it first brakes."""
+    v, d = speed, light_m
+    hardest, first_brake, still = 0, math.nan, 0
+    for _ in range(200):
+        change = speed_change(int(np.argmax(policy.q_values(_obs(cmd, v, limit, d)))))
+        if change < 0 and math.isnan(first_brake):
+            first_brake = d
+        v_new = max(v + change, 0.0)
+        hardest = min(hardest, round(v_new - v))
+        v = v_new
+        d -= v
+        still = still + 1 if v == 0.0 else 0
+        if still >= 3 or d < 0.0:
+            break
+    return d, hardest, first_brake
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("policies", type=Path, nargs="+", help="policy .pt files")
+    parser.add_argument("--light-m", type=float, default=100.0, help="red light ahead [m]")
+    args = parser.parse_args()
+    print("| policy | limit km/h | settles m/s | share of limit | highest whole speed | "
+          "Q(+1) - max | brakes from m | hardest brake m/s | stands before the line m |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for path in args.policies:
+        policy = QPolicy.load(path)
+        cmd = int(Command.parse(policy.card["mode"]))
+        for kmh in LIMITS_KMH:
+            limit = kmh / 3.6
+            settled, gap = free_road(policy, cmd, limit)
+            stand, hardest, first = red_light(policy, cmd, limit, settled, args.light_m)
+            print(f"| {path} | {kmh} | {settled:.0f} | {settled / limit:.2f} | "
+                  f"{math.floor(limit)} | {gap:.1f} | {first:.0f} | {hardest} | {stand:.1f} |")
+
+
+if __name__ == "__main__":
+    main()
