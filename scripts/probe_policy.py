@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from explaindrive.agent.controller import QPolicy
-from explaindrive.env import state as S
 from explaindrive.commands import Command
+from explaindrive.env import state as S
 from explaindrive.env.actions import action_index, speed_change
 
 LIMITS_KMH = (30, 40, 50, 60, 70)
@@ -80,8 +80,10 @@ def main() -> None:
     parser.add_argument("policies", type=Path, nargs="+", help="policy .pt files")
     parser.add_argument("--light-m", type=float, default=100.0, help="red light ahead [m]")
     args = parser.parse_args()
-    print("| policy | limit km/h | settles m/s | share of limit | highest whole speed | "
-          "Q(+1) - max | brakes from m | hardest brake m/s | stands before the line m |")
+    print(
+        "| policy | limit km/h | settles m/s | share of limit | highest whole speed | "
+        "Q(+1) - max | brakes from m | hardest brake m/s | stands before the line m |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for path in args.policies:
         policy = QPolicy.load(path)
@@ -90,8 +92,10 @@ def main() -> None:
             limit = kmh / 3.6
             settled, gap = free_road(policy, cmd, limit)
             stand, hardest, first = red_light(policy, cmd, limit, settled, args.light_m)
-            print(f"| {path} | {kmh} | {settled:.0f} | {settled / limit:.2f} | "
-                  f"{math.floor(limit)} | {gap:.1f} | {first:.0f} | {hardest} | {stand:.1f} |")
+            print(
+                f"| {path} | {kmh} | {settled:.0f} | {settled / limit:.2f} | "
+                f"{math.floor(limit)} | {gap:.1f} | {first:.0f} | {hardest} | {stand:.1f} |"
+            )
 
 
 if __name__ == "__main__":

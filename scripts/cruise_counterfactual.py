@@ -1,0 +1,104 @@
+"""Would the reward pay for a faster cruise than the network drives? Each episode twice.
+
+    python scripts/cruise_counterfactual.py runs/comfort/seed-2/policy.pt \
+        --seeds 1000-1004 --traffic 0.5,1.0 [--below 1]
+
+Every episode runs once on the bare network's greedy choice and once on the same choice
+except on a free road (:func:`~explaindrive.env.ride_quality.free_road`, as the ride figures
+define it): where the network would not accelerate and the car is more than ``--below`` m/s
+under the highest whole speed within the posted limit, it takes +1 m/s if the safety rule
+allows it. Both runs collect the reward of the network's own recipe (its card) under its
+own command; the script prints both returns and the terms that differ by more than 0.5.
+
+A higher return for the forced cruise on most episodes says the network's values, not its
+reward, keep it slow: its value of the faster speed is too low, which a change of the
+reward cannot fix.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from explaindrive.agent.controller import QPolicy
+from explaindrive.env import state as S
+from explaindrive.env.actions import action_index, speed_change
+from explaindrive.env.config import EnvConfig
+from explaindrive.env.ride_quality import is_free_road
+from explaindrive.env.safety import safe_action_mask
+from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.evaluation.parsing import parse_levels, parse_seeds
+
+ACCELERATE = action_index(1)
+
+
+def episode(
+    policy: QPolicy, seed: int, traffic: float, below: float | None
+) -> tuple[float, int, int, dict[str, float]]:
+    """One episode: its return, steps, forced steps and the sum of each reward term."""
+    mode = str(policy.card["mode"])
+    config = policy.card.get("config", {})
+    env = UrbanDriveEnv(
+        config=EnvConfig(
+            traffic_level=traffic,
+            yellow_leader=policy.yellow_leader,
+            reward=config.get("reward", "paper"),
+        )
+    )
+    try:
+        obs, info = env.reset(seed=seed, options={"command": mode, "traffic_level": traffic})
+        total, steps, forced, terms = 0.0, 0, 0, dict[str, float]()
+        free, done = False, False
+        while not done:
+            action = int(np.argmax(policy.q_values(obs)))
+            if below is not None and free and speed_change(action) <= 0:
+                highest = math.floor(float(obs[S.V_LIM]) + 1e-9)
+                if obs[S.V_EGO] < highest - below - 1e-6 and safe_action_mask(obs)[ACCELERATE]:
+                    action, forced = ACCELERATE, forced + 1
+            obs, reward, terminated, truncated, info = env.step(action)
+            done = terminated or truncated
+            free = is_free_road(info)
+            total, steps = total + float(reward), steps + 1
+            for name, value in info["reward_terms"].items():
+                terms[name] = terms.get(name, 0.0) + float(value)
+        return total, steps, forced, terms
+    finally:
+        env.close()
+
+
+def _differences(forced: dict[str, Any], as_is: dict[str, Any]) -> str:
+    diff = {k: forced.get(k, 0.0) - as_is.get(k, 0.0) for k in sorted({*forced, *as_is})}
+    return ", ".join(f"{k} {v:+.1f}" for k, v in diff.items() if abs(v) > 0.5 and k != "total")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("policy", type=Path, help="a policy .pt file")
+    parser.add_argument("--seeds", default="1000-1004", help="e.g. 1000-1004 (validation seeds)")
+    parser.add_argument("--traffic", default="0.5,1.0", help="comma-separated traffic levels")
+    parser.add_argument(
+        "--below", type=float, default=1.0, help="force +1 while this far under the top speed"
+    )
+    args = parser.parse_args()
+    policy = QPolicy.load(args.policy)
+    levels = parse_levels(args.traffic)
+    print("| seed | traffic | return as is | return forced | forced steps | terms forced - as is |")
+    print("|---|---|---|---|---|---|")
+    better = runs = 0
+    for seed in parse_seeds(args.seeds):
+        for traffic in levels:
+            as_is = episode(policy, seed, traffic, None)
+            forced = episode(policy, seed, traffic, args.below)
+            better, runs = better + int(forced[0] > as_is[0]), runs + 1
+            print(f"| {seed} | {traffic} | {as_is[0]:.1f} ({as_is[1]} steps) | "
+                  f"{forced[0]:.1f} ({forced[1]} steps) | {forced[2]} | "
+                  f"{_differences(forced[3], as_is[3])} |")  # fmt: skip
+    print(f"\nthe forced cruise returns more in {better} of {runs} episodes")
+
+
+if __name__ == "__main__":
+    main()
