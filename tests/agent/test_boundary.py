@@ -98,7 +98,7 @@ def test_boundary_loss_pushes_the_unsafe_actions_of_synthetic_rows_down() -> Non
 
 @pytest.mark.parametrize("boundary_margin", [None, 5.0])
 def test_the_boundary_rows_have_their_own_margin(boundary_margin: float | None) -> None:
-    # A row 3 m before a red line at 13.89 m/s: only -3 is safe. The loss on it is the mean
+    # A row 3 m before a red line at 13.89 m/s: only -3 is safe. The loss on it is the summed
     # squared excess of the six unsafe values over (best safe - margin), computed by hand
     # from the values before the update; the margin is unsafe_margin (30) unless set.
     config = PASSENGER.replace(boundary_weight=1.0, boundary_margin=boundary_margin, loss="mse")

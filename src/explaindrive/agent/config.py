@@ -172,9 +172,7 @@ class TrainConfig(ConfigModel, ScenarioFields):
     turns it off."""
     boundary_margin: PositiveFloat | None = None
     """How far below the best safe action the unsafe actions of those synthetic rows are
-    pushed; ``None`` uses ``unsafe_margin``. A smaller margin orders the actions of states
-    near the boundary without pulling down the same actions in the safe states around
-    them."""
+    pushed; ``None`` uses ``unsafe_margin``."""
     dilemma_braking: bool = True
     """Whether the safety mask of learning leaves braking in a yellow light's dilemma zone
     (where even the hardest braking cannot stop before the line) to the rewards; ``False``
