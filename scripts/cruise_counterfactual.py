@@ -11,8 +11,7 @@ allows it. Both runs collect the reward of the network's own recipe (its card) u
 own command; the script prints both returns and the terms that differ by more than 0.5.
 
 A higher return for the forced cruise on most episodes says the network's values, not its
-reward, keep it slow: its value of the faster speed is too low, which a change of the
-reward cannot fix.
+reward, keep it slow: its value of the faster speed is too low.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Where a network settles on a free road and before a red light, probed without SUMO.
 
     python scripts/probe_policy.py src/explaindrive/agent/policies/fast.pt \
-        src/explaindrive/agent/policies/comfort.pt [--noise-free-only]
+        src/explaindrive/agent/policies/comfort.pt [--light-m 100]
 
 Both probes follow the network's greedy (bare) choice on made-up states, with the
 environment's kinematics: the speed change applies at once and the car covers its new
@@ -14,8 +14,7 @@ speed in the 1 s step.
   the approach until the car stands: the distance it stands from the line, its hardest
   braking and how far from the line it starts braking.
 
-A network trained with observation noise settles below what the noise-free state would
-allow; these probes show by how much, state by state, where the evaluation's averages
+These probes show, state by state, where a network settles; the evaluation's averages
 (free-road speed share, standstill distance) only show the result.
 """
 
