@@ -190,6 +190,11 @@ def _with_added_fields(saved: dict[str, Any]) -> dict[str, Any]:
     return {**{k: v for k, v in ADDED_FIELDS.items() if k not in saved}, **saved}
 
 
+PRESET_CHANGED_SINCE = {"fast": {"boundary_weight": 0.0}, "comfort": {"boundary_weight": 0.0}}
+"""Per shipped card, the passenger preset's settings it was trained before (with their value
+on the card)."""
+
+
 @pytest.mark.parametrize("name", SHIPPED_POLICIES)
 def test_shipped_cards_load_exactly(name: str) -> None:
     saved = _card_config(name)
@@ -200,7 +205,11 @@ def test_shipped_cards_load_exactly(name: str) -> None:
     assert c.to_json() == json.dumps(saved, indent=2, sort_keys=True)
     # the shipped networks are the passenger preset's, with their own seed
     assert c == preset("passenger").replace(
-        mode=name, num_envs=saved["num_envs"], seed=saved["seed"], episodes=1200
+        mode=name,
+        num_envs=saved["num_envs"],
+        seed=saved["seed"],
+        episodes=1200,
+        **PRESET_CHANGED_SINCE[name],
     )
 
 

@@ -272,6 +272,7 @@ PASSENGER = SAFE.replace(
     reward="passenger",
     yellow_leader="gentle",
     unsafe_margin=30.0,
+    boundary_weight=0.25,
     obs_noise_max=(3.0, 0.9),
     stop_when_safe=None,
     scenario="random",
@@ -279,7 +280,8 @@ PASSENGER = SAFE.replace(
 )
 """The default: ``safe``'s learning with the ``passenger`` reward recipe and the ``gentle``
 decision at yellow (:mod:`explaindrive.env.lights`) over 1,200 episodes (the shipped
-networks' budget), observation noise up to 3 m / 0.9 m/s drawn in half of the
+networks' budget), the unsafe-action loss also on synthetic rows near the safety boundary at
+a quarter of its weight (:mod:`explaindrive.agent.boundary`), observation noise up to 3 m / 0.9 m/s drawn in half of the
 episodes, every episode trained (no early end: a run that is safe early still has to learn
 to drive well), on the scenario family: a new scenario every 20 episodes, the paper's road in
 a quarter of the draws and generated ones in the rest."""
