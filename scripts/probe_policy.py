@@ -9,7 +9,10 @@ speed in the 1 s step.
 
 - Free road, per posted limit: from a standstill with nothing in range, the speed where the
   network stops accelerating, its share of the limit, the highest whole speed under the
-  limit, and how far Q(+1) lies below the best action at the settled speed.
+  limit, and how far Q(+1) lies below the best action at the settled speed. Then, on speeds
+  in steps of 0.1 m/s, the lowest speed from which Q(+1) stays below Q(0) up to the limit:
+  +1 becomes illegal above the limit less 1 m/s, and how far under that the network gives
+  it up shows how far the values pushed down there spread to legal speeds.
 - Red light: from that settled speed, with a red light ``--light-m`` ahead as the leader,
   the approach until the car stands: the distance it stands from the line, its hardest
   braking and how far from the line it starts braking.
@@ -53,6 +56,18 @@ def free_road(policy: QPolicy, cmd: int, limit: float) -> tuple[float, float]:
     return v, math.nan
 
 
+def gives_up_plus_one(policy: QPolicy, cmd: int, limit: float) -> float:
+    """The lowest speed, in steps of 0.1 m/s up to ``limit``, from which Q(+1) < Q(0) on a
+    free road all the way to the limit."""
+    speeds = np.arange(0.0, limit + 1e-9, 0.1)
+    q = np.stack([policy.q_values(_obs(cmd, float(v), limit, None)) for v in speeds])
+    above = q[:, action_index(1)] >= q[:, action_index(0)]
+    last = np.flatnonzero(above)
+    if not len(last):
+        return 0.0
+    return float(speeds[last[-1] + 1]) if last[-1] + 1 < len(speeds) else math.nan
+
+
 def red_light(
     policy: QPolicy, cmd: int, limit: float, speed: float, light_m: float
 ) -> tuple[float, int, float]:
@@ -81,19 +96,22 @@ def main() -> None:
     args = parser.parse_args()
     print(
         "| policy | limit km/h | settles m/s | share of limit | highest whole speed | "
-        "Q(+1) - max | brakes from m | hardest brake m/s | stands before the line m |"
+        "Q(+1) - max | gives up +1 from m/s | brakes from m | hardest brake m/s | "
+        "stands before the line m |"
     )
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for path in args.policies:
         policy = QPolicy.load(path)
         cmd = int(Command.parse(policy.card["mode"]))
         for kmh in LIMITS_KMH:
             limit = kmh / 3.6
             settled, gap = free_road(policy, cmd, limit)
+            gives_up = gives_up_plus_one(policy, cmd, limit)
             stand, hardest, first = red_light(policy, cmd, limit, settled, args.light_m)
             print(
                 f"| {path} | {kmh} | {settled:.0f} | {settled / limit:.2f} | "
-                f"{math.floor(limit)} | {gap:.1f} | {first:.0f} | {hardest} | {stand:.1f} |"
+                f"{math.floor(limit)} | {gap:.1f} | {gives_up:.1f} | {first:.0f} | {hardest} | "
+                f"{stand:.1f} |"
             )
 
 
