@@ -281,10 +281,10 @@ PASSENGER = SAFE.replace(
 """The default: ``safe``'s learning with the ``passenger`` reward recipe and the ``gentle``
 decision at yellow (:mod:`explaindrive.env.lights`) over 1,200 episodes (the shipped
 networks' budget), the unsafe-action loss also on synthetic rows near the safety boundary at
-a quarter of its weight (:mod:`explaindrive.agent.boundary`), observation noise up to 3 m / 0.9 m/s drawn in half of the
-episodes, every episode trained (no early end: a run that is safe early still has to learn
-to drive well), on the scenario family: a new scenario every 20 episodes, the paper's road in
-a quarter of the draws and generated ones in the rest."""
+a quarter of its weight (:mod:`explaindrive.agent.boundary`), observation noise up to 3 m /
+0.9 m/s drawn in half of the episodes, every episode trained (no early end: a run that is
+safe early still has to learn to drive well), on the scenario family: a new scenario every 20
+episodes, the paper's road in a quarter of the draws and generated ones in the rest."""
 
 PRESETS: dict[str, TrainConfig] = {"paper": PAPER, "safe": SAFE, "passenger": PASSENGER}
 DEFAULT_PRESET = "passenger"
