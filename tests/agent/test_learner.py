@@ -7,11 +7,13 @@ import pytest
 import torch
 
 from explaindrive.agent.buffer import ReplayBatch, ReplayBuffer
-from explaindrive.agent.config import PAPER
+from explaindrive.agent.config import PAPER, PASSENGER
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.shield import training_mask
 from explaindrive.agent.targets import dueling_aggregate
+from explaindrive.config import ConfigError
+from explaindrive.env.safety import limit_mask
 from explaindrive.env.state import normalize
 
 
@@ -116,3 +118,33 @@ def test_learner_learns_a_contextual_bandit() -> None:
     assert np.mean(losses[-20:]) < 0.1 * np.mean(losses[:20])
     assert (learner.act(obs[:100], 0.0, rng) == 6).all()
     assert learner.updates == 300
+
+
+@pytest.mark.parametrize("limit_margin", [None, 5.0])
+def test_actions_over_the_limit_have_their_own_margin(limit_margin: float | None) -> None:
+    # Comfort at 12 m/s in the 13.89 m/s zone, a red line 35 m ahead: -3..0 are safe, +1
+    # (13 m/s) is unsafe for the light alone (standing after it needs 37 m), +2 and +3 also
+    # exceed the limit. The loss is the summed squared excess of the unsafe values over
+    # (best safe - margin), by hand from the values before the update: 30 for +1 and
+    # limit_margin (30 unless set) for +2 and +3.
+    config = PASSENGER.replace(loss="mse", limit_margin=limit_margin)
+    learner = D3QNLearner(config)
+    row = np.asarray([[1.0, 12.0, 13.89, 35.0, 12.0, 35.0, 2.0, 200.0]], dtype=np.float32)
+    mask = training_mask(row, True)
+    assert mask[0].tolist() == [True] * 4 + [False] * 3
+    assert limit_mask(row)[0].tolist() == [True] * 5 + [False] * 2
+    q = learner.q_values(row)[0].astype(np.float64)
+    best = q[:4].max()
+    floors = best - np.array([30.0, limit_margin or 30.0, limit_margin or 30.0])
+    expected = float(np.sum(np.maximum(q[4:] - floors, 0.0) ** 2))
+    batch = ReplayBatch(
+        obs=row, actions=np.array([0]), rewards=np.zeros(1, np.float32), next_obs=row,
+        terminated=np.ones(1, bool), discount=np.ones(1, np.float32),
+        mask=mask, next_mask=mask,
+    )  # fmt: skip
+    assert learner.update(batch, 0).unsafe_loss == pytest.approx(expected, rel=1e-4)
+
+
+def test_limit_margin_needs_unsafe_margin() -> None:
+    with pytest.raises(ConfigError, match="limit_margin needs unsafe_margin"):
+        PAPER.replace(limit_margin=5.0)

@@ -92,3 +92,12 @@ def test_the_unsafe_loss_with_a_margin_pushes_below_the_best_safe_action() -> No
     q.requires_grad_(True)
     unsafe_action_loss(q, mask, unsafe_q=-100.0, margin=10.0).backward()
     assert q.grad is not None and float(q.grad[0, 0]) == 0.0
+
+
+def test_the_unsafe_loss_takes_one_margin_per_action() -> None:
+    q = torch.tensor([[5.0, 3.0, 8.0, -9.0]])
+    mask = torch.tensor([[True, False, False, False]])
+    margins = torch.tensor([[10.0, 10.0, 2.0, 2.0]])
+    # floors 5 - 10 = -5 for action 1 and 5 - 2 = 3 for actions 2 and 3: excess 8, 5 and 0
+    loss = unsafe_action_loss(q, mask, unsafe_q=-100.0, margin=margins)
+    assert float(loss) == pytest.approx(64 + 25)

@@ -152,6 +152,11 @@ class TrainConfig(ConfigModel, ScenarioFields):
     unsafe_margin: PositiveFloat | None = None
     """If set, unsafe actions are pushed to this far below the best safe action of their
     state instead of to ``unsafe_q`` (a large-margin loss; ``safe_learning``)."""
+    limit_margin: PositiveFloat | None = None
+    """If set (with ``unsafe_margin``), the actions that exceed the posted limit at the speed
+    the network sees are pushed this far below the best safe action, and the other unsafe
+    actions ``unsafe_margin``; on the synthetic rows too, unless ``boundary_margin`` is
+    set."""
     yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = DEFAULT_YELLOW_LEADER
     """When the environment makes a yellow light's stop line a virtual leader: ``decided``
     once by whether the car can still stop there, or ``always`` (the paper; see
@@ -212,6 +217,12 @@ class TrainConfig(ConfigModel, ScenarioFields):
         if not 0 < lo <= hi:
             raise ValueError(f"must be [min, max] with 0 < min <= max, got {[lo, hi]}")
         return bounds
+
+    @model_validator(mode="after")
+    def _limit_margin_needs_margins(self) -> TrainConfig:
+        if self.limit_margin is not None and self.unsafe_margin is None:
+            raise ValueError("limit_margin needs unsafe_margin (pushes relative to the best safe)")
+        return self
 
     @model_validator(mode="after")
     def _batch_fits_buffer(self) -> TrainConfig:

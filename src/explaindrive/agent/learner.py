@@ -19,6 +19,7 @@ from explaindrive.agent.targets import (
     unsafe_action_loss,
 )
 from explaindrive.env.actions import N_ACTIONS
+from explaindrive.env.safety import limit_mask
 
 
 @dataclass(frozen=True, slots=True)
@@ -112,6 +113,16 @@ class D3QNLearner:
         """Epsilon-greedy actions for a batch of raw observations, in one forward pass."""
         return self.explore(self.q_values(obs), epsilon, rng, mask)
 
+    def _margins(self, obs: np.ndarray) -> float | torch.Tensor | None:
+        """The unsafe-action loss's margins for raw observations ``obs``: ``unsafe_margin``,
+        or with ``limit_margin`` one per action, that one where the action exceeds the posted
+        limit at the speed the network sees."""
+        c = self.config
+        if c.limit_margin is None or c.unsafe_margin is None:
+            return c.unsafe_margin
+        over_limit = torch.from_numpy(~limit_mask(obs))
+        return torch.where(over_limit, c.limit_margin, c.unsafe_margin)
+
     def update(
         self,
         batch: ReplayBatch,
@@ -154,14 +165,16 @@ class D3QNLearner:
         if c.safe_learning:
             mask = torch.from_numpy(batch.mask)
             unsafe = unsafe_action_loss(
-                q_obs, mask, c.unsafe_q, c.loss, c.huber_delta, c.unsafe_margin
+                q_obs, mask, c.unsafe_q, c.loss, c.huber_delta, self._margins(batch.obs)
             )
             loss = td + c.unsafe_loss_weight * unsafe
             if boundary is not None:
+                margin = (
+                    self._margins(boundary[0]) if c.boundary_margin is None else c.boundary_margin
+                )
                 on_boundary = unsafe_action_loss(
                     q_all[2 * n :], torch.from_numpy(boundary[1]), c.unsafe_q, c.loss,
-                    c.huber_delta,
-                    c.unsafe_margin if c.boundary_margin is None else c.boundary_margin,
+                    c.huber_delta, margin,
                 )  # fmt: skip
                 loss = loss + c.boundary_weight * on_boundary
 

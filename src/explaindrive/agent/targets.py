@@ -69,7 +69,7 @@ def unsafe_action_loss(
     unsafe_q: float,
     kind: str = "mse",
     huber_delta: float = 1.0,
-    margin: float | None = None,
+    margin: float | Tensor | None = None,
 ) -> Tensor:
     """Loss that pushes the Q-value of every unsafe action down to ``unsafe_q``, or, with
     ``margin``, to ``margin`` below the best safe action of its state.
@@ -86,7 +86,8 @@ def unsafe_action_loss(
         unsafe_q: the value unsafe actions are pushed to.
         kind: ``mse`` or ``huber``, as :func:`td_loss`.
         huber_delta: threshold of the Huber loss.
-        margin: if set, the floor is the best safe Q-value (not differentiated) minus this.
+        margin: if set, the floor is the best safe Q-value (not differentiated) minus this:
+            one number, or one per action of each state, ``(B, n_actions)``.
     """
     floor = torch.full_like(q_values[:, :1], unsafe_q)
     if margin is not None:
