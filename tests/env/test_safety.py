@@ -76,3 +76,21 @@ def test_kept_outcomes_are_not_changed_by_a_mask() -> None:
     np.testing.assert_array_equal(
         runtime_mask(obs), safe_action_mask(obs[None], stop_progress=True)[0]
     )
+
+
+@pytest.mark.parametrize(
+    "outside",
+    [
+        lambda o: o[:, S.D_CROSS] >= S.SENSOR_RANGE_M,  # no crossing in range
+        lambda o: (o[:, S.D_TL] >= S.SENSOR_RANGE_M) | (np.rint(o[:, S.TLS]) == 0),  # no light
+        lambda o: o[:, S.D_LEAD] >= S.SENSOR_RANGE_M,  # no leader
+        lambda o: np.rint(o[:, S.CMD]) != 2,  # no STOP
+    ],
+)
+def test_a_batch_where_a_rule_never_applies_is_its_rows(outside) -> None:
+    rows = observations(4000, seed=3)
+    rows = rows[outside(rows)]
+    assert len(rows) > 100
+    batch = runtime_mask(rows)
+    for row, expected in zip(rows, batch, strict=True):
+        np.testing.assert_array_equal(runtime_mask(row), expected, err_msg=str(row))

@@ -150,28 +150,42 @@ def _unsafe(
     cmd, v, v_lim, gap, dv, d_tl, tls, d_cross = columns
     need = out.need
     unsafe = _over_limit(v_lim, out)
-    unsafe |= (d_cross < S.SENSOR_RANGE_M) & (need > d_cross)
+    # Each rule below applies only where its condition holds; where it holds for no
+    # observation the rule is skipped (one observation mostly has few objects in range).
+    crossing = d_cross < S.SENSOR_RANGE_M
+    if _anywhere(crossing):
+        unsafe |= crossing & (need > d_cross)
 
     tls = np.rint(tls)
     signal = tls != 0
     light = (d_tl < S.SENSOR_RANGE_M) & signal
-    must_go = light & (tls == 1) & ~(out.least_need <= d_tl)
-    unsafe |= light & ~must_go & (need > d_tl)
-    if not dilemma_braking:
-        unsafe |= must_go & out.slows
+    must_go = light  # no light in range: nothing must go
+    if _anywhere(light):
+        must_go = light & (tls == 1) & ~(out.least_need <= d_tl)
+        unsafe |= light & ~must_go & (need > d_tl)
+        if not dilemma_braking:
+            unsafe |= must_go & out.slows
 
     virtual = (signal & (np.abs(gap - d_tl) <= VIRTUAL_TOL_M)) | (
         np.abs(gap - d_cross) <= VIRTUAL_TOL_M
     )
     real = (gap < S.SENSOR_RANGE_M) & ~virtual
-    leader_v = np.maximum(v - dv, 0.0)
-    unsafe |= real & (gap + braking_distances(leader_v, LEADER_BRAKE_MPS) < need)
+    if _anywhere(real):
+        leader_v = np.maximum(v - dv, 0.0)
+        unsafe |= real & (gap + braking_distances(leader_v, LEADER_BRAKE_MPS) < need)
 
     if stop_progress:
         stopping = np.rint(cmd) == int(Command.STOP)
-        clearing = must_go & out.keeps  # in the dilemma zone: clear the junction first
-        unsafe |= stopping & ~(out.closer | clearing)
+        if _anywhere(stopping):
+            clearing = must_go & out.keeps  # in the dilemma zone: clear the junction first
+            unsafe |= stopping & ~(out.closer | clearing)
     return unsafe
+
+
+def _anywhere(condition: Any) -> bool:
+    """Whether ``condition`` (a boolean column, or one numpy boolean) holds for any
+    observation; a scalar is tested directly (``ndarray.any`` costs microseconds)."""
+    return bool(condition) if condition.ndim == 0 else bool(condition.any())
 
 
 def _over_limit(v_lim: Any, out: ActionOutcomes) -> NDArray[np.bool_]:
