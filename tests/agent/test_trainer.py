@@ -220,6 +220,32 @@ def test_n_step_queue_by_hand() -> None:
     assert (cut[2], cut[4], cut[5]) == (1.0, False, 0.5)
 
 
+def test_n_step_queue_cut_at_exploration_by_hand() -> None:
+    q = NStepQueue(3, 0.5, cut=True)
+    obs = [np.full(8, float(i), np.float32) for i in range(6)]
+    masks = [np.arange(7) < i + 1 for i in range(6)]  # a different mask for every state
+
+    def push(i: int, reward: float, greedy: bool = True, done: bool = False) -> list:
+        return q.push(obs[i], i, reward, masks[i], obs[i + 1], masks[i + 1], False, done,
+                      greedy=greedy)  # fmt: skip
+
+    assert push(0, 1.0) == []
+    assert push(1, 2.0, greedy=False) == []
+    # step 1 explored: step 0's return is r_0 = 1 alone, bootstrapped from obs[1] (0.5^1)
+    (t0,) = push(2, 4.0)
+    assert (t0.obs[0], t0.action, t0.reward, t0.next_obs[0], t0.discount) == (0, 0, 1.0, 1, 0.5)
+    assert not t0.terminated and t0.next_mask.sum() == 2  # obs[1]'s mask
+    # step 1's own action may explore: its return runs on, 2 + 0.5 * 4 + 0.25 * 8 = 6
+    (t1,) = push(3, 8.0)
+    assert (t1.action, t1.reward, t1.next_obs[0], t1.discount) == (1, 6.0, 4, 0.125)
+    # at the end step 4 explores: the returns of steps 2 and 3 stop before it (4 + 0.5 * 8
+    # and 8, from obs[4]); step 4's own is its reward, from the last state
+    tail = push(4, 16.0, greedy=False, done=True)
+    assert [(t.action, t.reward, t.next_obs[0], t.discount) for t in tail] == [
+        (2, 8.0, 4, 0.25), (3, 8.0, 4, 0.5), (4, 16.0, 5, 0.5),
+    ]  # fmt: skip
+
+
 class NearTheLimit(FakeDriveEnv):
     """Starts every episode at 9 m/s, 1 m/s under the limit."""
 

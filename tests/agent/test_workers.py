@@ -52,6 +52,22 @@ def test_a_worker_plays_its_reserved_episode_and_ships_n_step_transitions() -> N
     assert (idle.steps, idle.transitions) == (0, [])
 
 
+@pytest.mark.parametrize(("epsilon", "full_returns"), [(0.0, 2), (1.0, 0)])
+def test_cut_returns_stop_at_exploration_and_keep_the_random_stream(
+    epsilon: float, full_returns: int
+) -> None:
+    # 4 steps of a 5-step episode: two transitions leave, each spanning 3 steps when every
+    # action is the network's best; with every action random (epsilon 1) the second step
+    # of each return explores (on 4 steps of this seed), so each stops after one step
+    plain, cut = (RolloutWorker(CONFIG.replace(n_step_cut=c), FACTORY, 0) for c in (False, True))
+    a, b = (w.collect(CollectRequest(4, epsilon, _weights(), start=4)) for w in (plain, cut))
+    assert [t.action for t in a.transitions] == [t.action for t in b.transitions]
+    discounts = [t.discount for t in b.transitions]
+    assert len(discounts) == 2
+    assert discounts.count(pytest.approx(CONFIG.gamma**3)) == full_returns
+    assert discounts.count(pytest.approx(CONFIG.gamma)) == 2 - full_returns
+
+
 def test_local_processes_play_exactly_what_in_process_workers_play() -> None:
     requests = [CollectRequest(7, 0.3, _weights(), start) for start in (0, 1)]
     results = []

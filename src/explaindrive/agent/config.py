@@ -113,6 +113,12 @@ class TrainConfig(ConfigModel, ScenarioFields):
     """Transitions after which epsilon is ``eps_final``."""
     n_step: PositiveInt = 1
     """Steps summed in each bootstrapped return (1: the paper's one-step target)."""
+    n_step_cut: bool = False
+    """End each n-step return at the first exploratory action after its first step and
+    bootstrap from the state that action was taken in (Watkins's cut of Q(lambda)): the
+    returns then carry no exploration but their own first action's. An action is
+    exploratory when it is not the network's best one (the best allowed one in shielded
+    episodes)."""
     priority_alpha: Fraction = 0.0
     """Prioritised replay (:mod:`explaindrive.agent.prioritized`): transitions are sampled in
     proportion to their priority (absolute TD error) to this power; 0 samples uniformly

@@ -107,12 +107,14 @@ class NStepQueue:
     A transition leaves the queue when n steps have followed its state (return
     r_0 + g r_1 + ... + g^(n-1) r_(n-1), bootstrapped from the state n steps later with
     discount g^n), or when the episode ends (the shorter tail returns, each marked
-    terminated if the episode terminated).
+    terminated if the episode terminated). With ``cut``, a return stops before the first
+    later step whose action was exploratory (``greedy=False``) and bootstraps from that
+    step's state.
     """
 
-    def __init__(self, n: int, gamma: float) -> None:
-        self.n, self.gamma = n, gamma
-        self._steps: deque[tuple[np.ndarray, int, float, np.ndarray]] = deque()
+    def __init__(self, n: int, gamma: float, cut: bool = False) -> None:
+        self.n, self.gamma, self.cut = n, gamma, cut
+        self._steps: deque[tuple[np.ndarray, int, float, np.ndarray, bool]] = deque()
 
     def push(
         self,
@@ -124,17 +126,34 @@ class NStepQueue:
         next_mask: np.ndarray,
         terminated: bool,
         done: bool,
+        greedy: bool = True,
     ) -> list[Transition]:
         """Add one step; returns the transitions it completes."""
-        self._steps.append((obs, action, reward, mask))
+        self._steps.append((obs, action, reward, mask, greedy))
         out: list[Transition] = []
         while self._steps and (done or len(self._steps) >= self.n):
-            ret = sum(self.gamma**k * step[2] for k, step in enumerate(self._steps))
-            first_obs, first_action, _, first_mask = self._steps.popleft()
-            discount = self.gamma ** (len(self._steps) + 1)
-            out.append(Transition(first_obs, first_action, ret, next_obs, terminated and done,
-                                  discount, first_mask, next_mask))  # fmt: skip
+            span = self._span()
+            ret = sum(self.gamma**k * self._steps[k][2] for k in range(span))
+            first_obs, first_action, _, first_mask, _ = self._steps.popleft()
+            discount = self.gamma**span
+            if span <= len(self._steps):  # cut: bootstrap from the exploratory step's state
+                cut_obs, _, _, cut_mask, _ = self._steps[span - 1]
+                out.append(Transition(first_obs, first_action, ret, cut_obs, False, discount,
+                                      first_mask, cut_mask))  # fmt: skip
+            else:
+                out.append(Transition(first_obs, first_action, ret, next_obs,
+                                      terminated and done, discount, first_mask,
+                                      next_mask))  # fmt: skip
         return out
+
+    def _span(self) -> int:
+        """Steps the first queued step's return sums: all queued ones, or with ``cut`` those
+        before the first later exploratory step."""
+        if self.cut:
+            for k in range(1, len(self._steps)):
+                if not self._steps[k][4]:
+                    return k
+        return len(self._steps)
 
 
 @dataclass(frozen=True)
@@ -276,7 +295,7 @@ class RolloutWorker:
                 plan.index, plan.seed, plan.traffic_level, plan.has_stops, shielded
             )
             return _Running(
-                plan, summary, NStepQueue(c.n_step, c.gamma),
+                plan, summary, NStepQueue(c.n_step, c.gamma, c.n_step_cut),
                 np.random.default_rng([c.seed, 3, plan.index]), obs,
                 learning_mask(obs, true_obs, c.dilemma_braking), _allowed(info),
             )  # fmt: skip
@@ -291,14 +310,16 @@ class RolloutWorker:
         greedy_unsafe = not ep.allowed[int(q[0].argmax())]
         act_mask = ep.mask[None] if ep.summary.shielded else None
         action = int(D3QNLearner.explore(q, epsilon, ep.rng, act_mask)[0])
+        best = q[0] if act_mask is None else np.where(act_mask[0], q[0], -np.inf)
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         next_obs = np.asarray(next_obs, dtype=np.float32)
         next_true = _true_state(next_obs, info)
         next_mask = learning_mask(next_obs, next_true, self.config.dilemma_braking)
         done = bool(terminated or truncated)
         out.transitions += ep.queue.push(
-            ep.obs, action, float(reward), ep.mask, next_obs, next_mask, bool(terminated), done
-        )
+            ep.obs, action, float(reward), ep.mask, next_obs, next_mask, bool(terminated), done,
+            greedy=action == int(best.argmax()),
+        )  # fmt: skip
         out.steps += 1
         ep.summary.record(float(reward), info, greedy_unsafe)
         ep.obs, ep.mask, ep.allowed = next_obs, next_mask, _allowed(info)
