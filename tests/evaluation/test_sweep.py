@@ -35,3 +35,13 @@ def test_finished_seeds_are_evaluated_into_one_table(tmp_path: Path) -> None:
     assert "bare networks, seeds 0-0 x traffic 1.0" in table and "| spread (std) |" in table
     doc = json.loads((tmp_path / "seeds.json").read_text())
     assert [Path(d["run"]).name for d in doc] == ["seed-0", "seed-1"]
+
+
+def test_seeds_trained_by_an_earlier_command_keep_their_row(tmp_path: Path) -> None:
+    _constant_run(tmp_path, 0, 3)  # trained by an earlier `--seeds 0` into the same folder
+    _constant_run(tmp_path, 1, 3)
+    (tmp_path / "seed-notes").mkdir()  # not a seed folder
+    results = evaluate_seeds(tmp_path, [1], [0], [1.0], None, workers=1)
+    assert [Path(r.run).name for r in results] == ["seed-0", "seed-1"]
+    doc = json.loads((tmp_path / "seeds.json").read_text())
+    assert [Path(d["run"]).name for d in doc] == ["seed-0", "seed-1"]

@@ -30,6 +30,16 @@ def seed_run_dir(out: Path, seed: int) -> Path:
     return out / f"seed-{seed}"
 
 
+def _seeds_in(out: Path) -> set[int]:
+    """The seeds of the ``seed-<s>`` run folders in ``out``."""
+    found = set()
+    for path in out.glob("seed-*"):
+        suffix = path.name.removeprefix("seed-")
+        if path.is_dir() and suffix.isdigit():
+            found.add(int(suffix))
+    return found
+
+
 def train_seeds(train_args: Sequence[str], seeds: Sequence[int], out: Path) -> dict[int, int]:
     """Run ``explaindrive train <train_args> --seed s --out out/seed-s`` for every seed at
     once; returns each process's exit status."""
@@ -51,8 +61,12 @@ def evaluate_seeds(
     stop_schedule: str | None,
     workers: int | None = None,
 ) -> list[SeedResult]:
-    """Evaluate the bare network of every seed that finished; write ``seeds.md``/``.json``."""
-    runs = [str(seed_run_dir(out, s)) for s in seeds
+    """Evaluate the bare network of every seed that finished; write ``seeds.md``/``.json``.
+
+    The table covers the folder: seeds that earlier ``--seeds`` commands trained into ``out``
+    are evaluated again beside ``seeds``, so separate commands never overwrite each other's
+    rows."""
+    runs = [str(seed_run_dir(out, s)) for s in sorted(set(seeds) | _seeds_in(out))
             if (seed_run_dir(out, s) / "policy.pt").is_file()]  # fmt: skip
     results = evaluate_runs(
         runs, eval_seeds, levels, stop_schedule=stop_schedule, shield=False, workers=workers
