@@ -11,6 +11,7 @@ from explaindrive.agent.buffer import ReplayBatch
 from explaindrive.agent.config import PASSENGER
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.shield import training_mask
+from explaindrive.config import ConfigError
 from explaindrive.env import state as S
 from explaindrive.env.actions import stopping_needs
 
@@ -75,6 +76,39 @@ def test_the_masks_are_the_rules_and_many_rows_sit_on_the_boundary() -> None:
     unsafe_share = (~mask).mean(axis=0)
     assert unsafe_share[0] == 0.0 and np.all(np.diff(unsafe_share[1:]) > 0.05)
     assert unsafe_share[1] > 0.15 and unsafe_share[6] < 0.95
+
+
+def test_noisy_rows_keep_the_masks_of_the_rows_without_noise() -> None:
+    obs = np.asarray([FOLLOWING, RED_AHEAD, EMPTY] * 2000, dtype=np.float32)
+    clean, clean_mask = boundary_batch(obs, np.random.default_rng(4), True)
+    rng = np.random.default_rng(4)
+    seen, mask = boundary_batch(obs, rng, True, noise_max=(3.0, 0.9), noisy_share=0.5)
+    np.testing.assert_array_equal(mask, clean_mask)  # the same synthetic rows, the same masks
+    moved = seen[:, S.V_EGO] != clean[:, S.V_EGO]
+    assert moved.mean() == pytest.approx(0.5, abs=0.03)  # noisy_share of the rows
+    # deviations uniform in [0, 0.9]: the mean absolute error is 0.45 * sqrt(2 / pi)
+    error = np.abs(seen[moved, S.V_EGO] - clean[moved, S.V_EGO])
+    assert error.mean() == pytest.approx(0.45 * np.sqrt(2 / np.pi), rel=0.08)
+    assert np.all(seen[~moved] == clean[~moved])
+    # a seen speed well under the limit whose true speed is at it: +1 is unsafe there
+    at_limit = (clean[:, S.V_EGO] >= 13.0) & (seen[:, S.V_EGO] < 12.0) & (clean[:, S.TLS] == 0)
+    assert at_limit.any() and not mask[at_limit, 4].any()
+
+
+def test_without_noise_nothing_more_is_drawn() -> None:
+    obs = np.asarray([FOLLOWING, RED_AHEAD], dtype=np.float32)
+    a, b = np.random.default_rng(1), np.random.default_rng(1)
+    boundary_batch(obs, a, True)
+    boundary_batch(obs, b, True, noise_max=(3.0, 0.9), noisy_share=0.0)
+    assert a.random() == b.random()
+
+
+def test_boundary_noise_needs_noise_and_rows() -> None:
+    with pytest.raises(ConfigError, match="boundary_noise needs obs_noise_max and boundary_wei"):
+        PASSENGER.replace(boundary_noise=True, obs_noise_max=(0.0, 0.0))
+    with pytest.raises(ConfigError, match="boundary_noise needs"):
+        PASSENGER.replace(boundary_noise=True, boundary_weight=0.0)
+    assert PASSENGER.replace(boundary_noise=True).boundary_noise
 
 
 def test_boundary_loss_pushes_the_unsafe_actions_of_synthetic_rows_down() -> None:

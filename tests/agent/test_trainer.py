@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from explaindrive.agent import trainer as trainer_module
 from explaindrive.agent.checkpoint import CheckpointError, load_checkpoint
 from explaindrive.agent.config import SEED_POOL_BASE, TrainConfig, preset
 from explaindrive.agent.controller import QPolicy
@@ -159,6 +160,7 @@ SCRIPT = """
 import functools, sys
 sys.path.insert(0, {root!r})
 from explaindrive.agent.config import TrainConfig
+from explaindrive.agent import trainer as trainer_module
 from explaindrive.agent.trainer import train
 from tests.agent.fake_drive_env import FakeDriveEnv
 config = TrainConfig.from_dict({config!r})
@@ -296,3 +298,22 @@ def test_boundary_states_join_the_updates(tmp_path: Path) -> None:
     events.Reload()
     losses = [e.value for e in events.Scalars("losses/boundary_loss")]
     assert len(losses) == 1 and losses[0] >= 0.0  # logged at update 10
+
+
+@pytest.mark.parametrize("boundary_noise", [False, True])
+def test_boundary_rows_are_seen_through_noise_when_asked(
+    boundary_noise: bool, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    seen: list[tuple[object, ...]] = []
+    real = trainer_module.boundary_batch
+
+    def spy(*args: object) -> object:
+        seen.append(args[3:])
+        return real(*args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(trainer_module, "boundary_batch", spy)
+    config = tiny(episodes=4, boundary_weight=1.0, obs_noise_max=[2.0, 0.6], noisy_share=0.5,
+                  boundary_noise=boundary_noise)  # fmt: skip
+    train(config, tmp_path, env_factory=FACTORY)
+    expected = ((2.0, 0.6) if boundary_noise else (0.0, 0.0), 0.5)
+    assert seen and all(args == expected for args in seen)

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from explaindrive.env import state as S
-from explaindrive.env.noise import ObservationNoise, parse_noise
+from explaindrive.env.noise import ObservationNoise, noisy_rows, parse_noise
 
 OBS = np.array([0.0, 10.0, 13.89, 40.0, 2.0, 200.0, 2.0, 0.5], dtype=np.float32)
 
@@ -30,6 +30,25 @@ def test_no_noise_is_the_identity():
     seen = ObservationNoise().apply(OBS, np.random.default_rng(0))
     assert not ObservationNoise().active
     np.testing.assert_array_equal(seen, OBS)
+
+
+def test_rows_draw_what_one_observation_draws():
+    one = ObservationNoise(2.0, 0.5).apply(OBS, np.random.default_rng(3))
+    rows = noisy_rows(OBS[None], np.array([2.0]), np.array([0.5]), np.random.default_rng(3))
+    np.testing.assert_array_equal(rows[0], one)
+
+
+def test_each_row_has_its_own_deviations():
+    obs = np.repeat(OBS[None], 3, axis=0)
+    rows = noisy_rows(obs, np.array([0.0, 2.0, 0.0]), np.array([0.0, 0.0, 0.5]),
+                      np.random.default_rng(5))  # fmt: skip
+    draws = np.random.default_rng(5).standard_normal((3, 5))
+    np.testing.assert_array_equal(rows[0], OBS)  # no noise: unchanged
+    assert rows[1, S.D_LEAD] == pytest.approx(40.0 + 2.0 * draws[1, 0], abs=1e-5)
+    assert rows[1, S.V_EGO] == 10.0 and rows[2, S.D_LEAD] == 40.0
+    assert rows[2, S.V_EGO] == pytest.approx(10.0 + 0.5 * draws[2, 3], abs=1e-5)
+    assert rows[2, S.DV] == pytest.approx(2.0 + 0.5 * draws[2, 4], abs=1e-5)
+    assert np.all(rows[:, S.D_TL] == 200.0)
 
 
 def test_parse_noise():

@@ -23,6 +23,14 @@ yields one synthetic observation:
 The masks of these rows are computed by the same rule; the learner pushes their unsafe
 actions below their best safe one (:func:`~explaindrive.agent.targets.unsafe_action_loss`),
 weighted by ``boundary_weight``. Nothing else is learned from them: they have no reward.
+
+With ``boundary_noise`` the network sees each synthetic row through observation noise
+(:func:`~explaindrive.env.noise.noisy_rows`) drawn as the episodes draw theirs: a share
+``noisy_share`` of the rows gets deviations uniform between 0 and ``obs_noise_max``. Its mask
+stays that of the noise-free row. The episodes teach a noisy view only where the car drove
+(a network that keeps 1 m/s under the limit is seldom at the limit, so it seldom learns that
+a low reading may be the limit); these rows straddle every boundary, so the network learns
+which actions may be unsafe for what it sees.
 """
 
 from __future__ import annotations
@@ -33,6 +41,7 @@ from numpy.typing import NDArray
 from explaindrive.agent.shield import training_mask
 from explaindrive.env import state as S
 from explaindrive.env.actions import SPEED_CHANGES_MPS, stopping_needs
+from explaindrive.env.noise import noisy_rows
 
 BOUNDARY_SPAN = 1.2
 """Synthetic distances are drawn up to this many times what the strongest acceleration
@@ -73,8 +82,21 @@ def boundary_observations(
 
 
 def boundary_batch(
-    obs: NDArray[np.floating], rng: np.random.Generator, dilemma_braking: bool
+    obs: NDArray[np.floating],
+    rng: np.random.Generator,
+    dilemma_braking: bool,
+    noise_max: tuple[float, float] = (0.0, 0.0),
+    noisy_share: float = 0.0,
 ) -> tuple[NDArray[np.float32], NDArray[np.bool_]]:
-    """Synthetic observations for a minibatch and their learning masks."""
+    """Synthetic observations for a minibatch and their learning masks; with ``noise_max``
+    and ``noisy_share`` set, the observations as seen through noise (the module docstring).
+    Without noise nothing more is drawn from ``rng``."""
     synthetic = boundary_observations(obs, rng)
-    return synthetic, training_mask(synthetic, dilemma_braking)
+    mask = training_mask(synthetic, dilemma_braking)
+    if noisy_share > 0.0 and noise_max != (0.0, 0.0):
+        u = rng.uniform(size=(len(synthetic), 3))
+        noisy = u[:, 2] < noisy_share
+        sd_m = np.where(noisy, u[:, 0] * noise_max[0], 0.0)
+        sd_mps = np.where(noisy, u[:, 1] * noise_max[1], 0.0)
+        synthetic = noisy_rows(synthetic, sd_m, sd_mps, rng)
+    return synthetic, mask

@@ -184,6 +184,10 @@ class TrainConfig(ConfigModel, ScenarioFields):
     boundary_margin: PositiveFloat | None = None
     """How far below the best safe action the unsafe actions of those synthetic rows are
     pushed; ``None`` uses ``unsafe_margin``."""
+    boundary_noise: bool = False
+    """Whether the network sees those synthetic rows through observation noise drawn as the
+    episodes' (``obs_noise_max``, ``noisy_share``), their masks staying those of the
+    noise-free rows: it learns which actions may be unsafe for what it sees."""
     dilemma_braking: bool = True
     """Whether the safety mask of learning leaves braking in a yellow light's dilemma zone
     (where even the hardest braking cannot stop before the line) to the rewards; ``False``
@@ -228,6 +232,14 @@ class TrainConfig(ConfigModel, ScenarioFields):
     def _limit_margin_needs_margins(self) -> TrainConfig:
         if self.limit_margin is not None and self.unsafe_margin is None:
             raise ValueError("limit_margin needs unsafe_margin (pushes relative to the best safe)")
+        return self
+
+    @model_validator(mode="after")
+    def _boundary_noise_needs_noise(self) -> TrainConfig:
+        if self.boundary_noise and (
+            self.obs_noise_max == (0.0, 0.0) or self.boundary_weight == 0.0
+        ):
+            raise ValueError("boundary_noise needs obs_noise_max and boundary_weight")
         return self
 
     @model_validator(mode="after")

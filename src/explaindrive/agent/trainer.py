@@ -296,7 +296,10 @@ class Trainer:
                 batch = buffer.sample(c.batch_size, s.rng)
             boundary = None
             if c.safe_learning and c.boundary_weight > 0.0:
-                boundary = boundary_batch(batch.obs, s.rng, c.dilemma_braking)
+                noise_max = c.obs_noise_max if c.boundary_noise else (0.0, 0.0)
+                boundary = boundary_batch(
+                    batch.obs, s.rng, c.dilemma_braking, noise_max, c.noisy_share
+                )
             stats = self.learner.update(batch, s.env_steps, boundary)
             if isinstance(buffer, PrioritizedReplayBuffer):
                 assert batch.indices is not None and stats.abs_td_errors is not None

@@ -51,19 +51,36 @@ class ObservationNoise:
         """A noisy copy of a raw observation (``obs`` is left as it is)."""
         import numpy as np
 
-        from explaindrive.env import state as S
-
-        out = obs.astype(np.float32, copy=True)
         if not self.active:
-            return out
-        draws = rng.standard_normal(5)
-        for k, i in enumerate((S.D_LEAD, S.D_TL, S.D_CROSS)):
-            if out[i] < S.SENSOR_RANGE_M:
-                out[i] = out[i] + self.sd_m * draws[k]
-        out[S.V_EGO] = out[S.V_EGO] + self.sd_mps * draws[3]
-        if out[S.D_LEAD] < S.SENSOR_RANGE_M:
-            out[S.DV] = out[S.DV] + self.sd_mps * draws[4]
-        return np.clip(out, S.STATE_LOW, S.STATE_HIGH).astype(np.float32)
+            return obs.astype(np.float32, copy=True)
+        row = obs.reshape(1, -1)
+        return noisy_rows(row, np.array([self.sd_m]), np.array([self.sd_mps]), rng)[0]
+
+
+def noisy_rows(
+    obs: NDArray[np.floating],
+    sd_m: NDArray[np.floating],
+    sd_mps: NDArray[np.floating],
+    rng: np.random.Generator,
+) -> NDArray[np.float32]:
+    """Noisy copies of raw observations of shape ``(B, 8)``, row ``i`` with standard
+    deviations ``sd_m[i]`` and ``sd_mps[i]``, by the rule of the module docstring. Draws five
+    standard normals per row, whatever its deviations (one row draws what
+    :meth:`ObservationNoise.apply` does)."""
+    import numpy as np
+
+    from explaindrive.env import state as S
+
+    out = np.array(obs, dtype=np.float32).reshape(-1, S.STATE_DIM)
+    draws = rng.standard_normal((len(out), 5))
+    sd_m, sd_mps = np.asarray(sd_m), np.asarray(sd_mps)
+    for k, i in enumerate((S.D_LEAD, S.D_TL, S.D_CROSS)):
+        detected = out[:, i] < S.SENSOR_RANGE_M
+        out[:, i] = np.where(detected, out[:, i] + sd_m * draws[:, k], out[:, i])
+    leader = out[:, S.D_LEAD] < S.SENSOR_RANGE_M  # the noisy gap decides, as for one row
+    out[:, S.V_EGO] = out[:, S.V_EGO] + sd_mps * draws[:, 3]
+    out[:, S.DV] = np.where(leader, out[:, S.DV] + sd_mps * draws[:, 4], out[:, S.DV])
+    return np.clip(out, S.STATE_LOW, S.STATE_HIGH).astype(np.float32)
 
 
 def parse_noise(text: str) -> ObservationNoise:
