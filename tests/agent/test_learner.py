@@ -148,3 +148,11 @@ def test_actions_over_the_limit_have_their_own_margin(limit_margin: float | None
 def test_limit_margin_needs_unsafe_margin() -> None:
     with pytest.raises(ConfigError, match="limit_margin needs unsafe_margin"):
         PAPER.replace(limit_margin=5.0)
+
+
+def test_best_actions_by_hand() -> None:
+    q = np.array([[0.0, 5.0, 1.0, 0, 0, 0, 9.0], [3.0, 2.0, 1.0, 0, 0, 0, 0]], dtype=np.float32)
+    assert D3QNLearner.best_actions(q).tolist() == [6, 0]
+    mask = np.ones((2, 7), bool)
+    mask[0, 6] = mask[1, 0] = False
+    assert D3QNLearner.best_actions(q, mask).tolist() == [1, 1]

@@ -99,9 +99,13 @@ class D3QNLearner:
         actions = np.where(explore, random_actions, greedy).astype(np.int64)
         if mask is not None:
             allowed = mask[np.arange(len(actions)), actions]
-            best_safe = np.where(mask, q_values, -np.inf).argmax(axis=-1)
-            actions = np.where(allowed, actions, best_safe)
+            actions = np.where(allowed, actions, D3QNLearner.best_actions(q_values, mask))
         return actions
+
+    @staticmethod
+    def best_actions(q_values: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
+        """The best-valued action of each row; with a ``mask``, the best-valued allowed one."""
+        return (q_values if mask is None else np.where(mask, q_values, -np.inf)).argmax(axis=-1)
 
     def act(
         self,

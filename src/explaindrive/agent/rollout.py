@@ -310,7 +310,10 @@ class RolloutWorker:
         greedy_unsafe = not ep.allowed[int(q[0].argmax())]
         act_mask = ep.mask[None] if ep.summary.shielded else None
         action = int(D3QNLearner.explore(q, epsilon, ep.rng, act_mask)[0])
-        best = q[0] if act_mask is None else np.where(act_mask[0], q[0], -np.inf)
+        # only the cut returns ask whether the action was the network's (allowed) best
+        greedy = not self.config.n_step_cut or action == int(
+            D3QNLearner.best_actions(q, act_mask)[0]
+        )
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         next_obs = np.asarray(next_obs, dtype=np.float32)
         next_true = _true_state(next_obs, info)
@@ -318,7 +321,7 @@ class RolloutWorker:
         done = bool(terminated or truncated)
         out.transitions += ep.queue.push(
             ep.obs, action, float(reward), ep.mask, next_obs, next_mask, bool(terminated), done,
-            greedy=action == int(best.argmax()),
+            greedy=greedy,
         )  # fmt: skip
         out.steps += 1
         ep.summary.record(float(reward), info, greedy_unsafe)
