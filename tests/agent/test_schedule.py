@@ -61,3 +61,20 @@ def test_observation_noise_is_drawn_per_episode_within_its_bounds() -> None:
         plans[7].seed, plans[7].traffic_level, plans[7].command_schedule,
     )  # fmt: skip
     assert "obs_noise" not in plain.reset_options()
+
+
+def test_the_speeds_can_have_a_noisy_share_of_their_own() -> None:
+    cfg = PAPER.replace(obs_noise_max=(3.0, 0.9), noisy_share=0.5)
+    both = [plan_episode(cfg, i).obs_noise for i in range(200)]
+    apart = [plan_episode(cfg.replace(speed_noisy_share=1.0), i).obs_noise for i in range(200)]
+    # the distances keep their draws; every episode's speeds are noisy, with the same sd
+    # where the distances are noisy too
+    assert [m for m, _ in apart] == [m for m, _ in both]
+    assert sum(s > 0.0 for _, s in apart) == 199  # one draw rounds to 0.0 m/s (as in both)
+    assert sum(s > 0.0 for _, s in both) == 101
+    assert all(a == b for a, b in zip(apart, both, strict=True) if b != (0.0, 0.0))
+    none = [plan_episode(cfg.replace(speed_noisy_share=0.0), i).obs_noise for i in range(200)]
+    assert [m for m, _ in none] == [m for m, _ in both] and all(s == 0.0 for _, s in none)
+    # the speeds' own share: about a quarter with 0.25
+    quarter = [plan_episode(cfg.replace(speed_noisy_share=0.25), i).obs_noise for i in range(200)]
+    assert 35 <= sum(s > 0.0 for _, s in quarter) <= 65

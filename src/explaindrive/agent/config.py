@@ -177,6 +177,10 @@ class TrainConfig(ConfigModel, ScenarioFields):
     the safety masks of learning are computed on the true state."""
     noisy_share: Fraction = 0.5
     """Share of the episodes with observation noise (when ``obs_noise_max`` is not zero)."""
+    speed_noisy_share: Fraction | None = None
+    """If set, the share of the episodes with noise on the speeds, drawn apart from the
+    distances' (which keep ``noisy_share``); ``None``: the speeds are noisy in the episodes
+    whose distances are."""
     boundary_weight: NonNegativeFloat = 0.0
     """Weight of the unsafe-action loss on one synthetic observation per minibatch row, moved
     near the safety boundary (:mod:`explaindrive.agent.boundary`; ``safe_learning``); 0

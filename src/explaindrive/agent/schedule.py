@@ -66,10 +66,12 @@ def plan_episode(config: TrainConfig, index: int) -> EpisodePlan:
     noise = (0.0, 0.0)
     if config.obs_noise_max != (0.0, 0.0):
         # a generator of its own: the plans of runs without noise stay as they were
-        u = np.random.default_rng([config.seed, index, 11]).uniform(size=3)
-        if u[2] < config.noisy_share:
-            noise = (
-                round(float(u[0]) * config.obs_noise_max[0], 3),
-                round(float(u[1]) * config.obs_noise_max[1], 3),
-            )
+        # the fourth draw only decides the speeds' share apart: the first three are as before
+        u = np.random.default_rng([config.seed, index, 11]).uniform(size=4)
+        speed_share = config.speed_noisy_share
+        noisy_speeds = u[2] < config.noisy_share if speed_share is None else u[3] < speed_share
+        noise = (
+            round(float(u[0]) * config.obs_noise_max[0], 3) if u[2] < config.noisy_share else 0.0,
+            round(float(u[1]) * config.obs_noise_max[1], 3) if noisy_speeds else 0.0,
+        )
     return EpisodePlan(index, seed, level, primary, schedule, noise)
