@@ -23,6 +23,9 @@ speed in the 1 s step.
   many steps in 1,000 exceed the limit: a single reading cannot tell the limit's whole speed
   from the one below it, so a network keeps a margin only where its values do.
 
+- Standing before a red line (50 km/h zone): at a standstill 9, 7 and 5 m before it, the value
+  of staying, Q(0), and how far Q(+1), creeping a metre closer, lies from it.
+
 These probes show, state by state, where a network settles; the evaluation's averages
 (free-road speed share, standstill distance) only show the result.
 """
@@ -122,6 +125,18 @@ def noisy_cruise(
     return mean / 1000, over
 
 
+STANDSTILL_M = (9.0, 7.0, 5.0)
+
+
+def standstill(policy: QPolicy, cmd: int, limit: float) -> list[tuple[float, float]]:
+    """At a standstill :data:`STANDSTILL_M` before a red line: Q(0) and Q(+1) - Q(0)."""
+    out = []
+    for d in STANDSTILL_M:
+        q = policy.q_values(_obs(cmd, 0.0, limit, d))
+        out.append((float(q[action_index(0)]), float(q[action_index(1)] - q[action_index(0)])))
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("policies", type=Path, nargs="+", help="policy .pt files")
@@ -150,6 +165,15 @@ def main() -> None:
                 f"{math.floor(limit)} | {gap:.1f} | {gives_up:.1f} | {first:.0f} | {hardest} | "
                 f"{stand:.1f} | {mean:.2f} | {over:.2f} |"
             )
+    metres = " / ".join(f"{d:.0f}" for d in STANDSTILL_M)
+    print(f"\n| policy | standing {metres} m before a red line: Q(0) | Q(+1) - Q(0) |")
+    print("|---|---|---|")
+    for path in args.policies:
+        policy = QPolicy.load(path)
+        values = standstill(policy, int(Command.parse(policy.card["mode"])), 50 / 3.6)
+        stay = " / ".join(f"{q:.1f}" for q, _ in values)
+        creep = " / ".join(f"{dq:.1f}" for _, dq in values)
+        print(f"| {path} | {stay} | {creep} |")
 
 
 if __name__ == "__main__":
