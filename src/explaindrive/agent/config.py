@@ -190,8 +190,9 @@ class TrainConfig(ConfigModel, ScenarioFields):
     pushed; ``None`` uses ``unsafe_margin``."""
     boundary_noise: bool = False
     """Whether the network sees those synthetic rows through observation noise drawn as the
-    episodes' (``obs_noise_max``, ``noisy_share``), their masks staying those of the
-    noise-free rows: it learns which actions may be unsafe for what it sees."""
+    episodes' (``obs_noise_max``, ``noisy_share`` for the speeds too, whatever
+    ``speed_noisy_share``), their masks staying those of the noise-free rows: it learns which
+    actions may be unsafe for what it sees."""
     dilemma_braking: bool = True
     """Whether the safety mask of learning leaves braking in a yellow light's dilemma zone
     (where even the hardest braking cannot stop before the line) to the rewards; ``False``
