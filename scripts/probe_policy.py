@@ -42,7 +42,7 @@ import torch
 from explaindrive.agent.controller import QPolicy
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.actions import action_index, speed_change
+from explaindrive.env.actions import SPEED_CHANGES_MPS, action_index, speed_change
 
 LIMITS_KMH = (30, 40, 50, 60, 70)
 
@@ -112,7 +112,7 @@ def noisy_cruise(
         obs[:, S.V_EGO] = np.clip(v + sd * rng.standard_normal(draws), 0.0, S.MAX_SPEED_MPS)
         with torch.no_grad():
             actions = policy.network(torch.from_numpy(obs)).argmax(dim=1).numpy()
-        changes = np.array([speed_change(int(a)) for a in range(7)])[actions]
+        changes = np.asarray(SPEED_CHANGES_MPS)[actions]
         after = np.clip(v + changes, 0.0, S.MAX_SPEED_MPS).astype(int)
         moves[i] = np.bincount(after, minlength=len(speeds)) / draws
     share = np.zeros(len(speeds))
@@ -151,8 +151,8 @@ def main() -> None:
         f"stands before the line m | noise {sd} m/s: mean m/s | speeding steps /1,000 |"
     )
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for path in args.policies:
-        policy = QPolicy.load(path)
+    policies = {path: QPolicy.load(path) for path in args.policies}
+    for path, policy in policies.items():
         cmd = int(Command.parse(policy.card["mode"]))
         for kmh in LIMITS_KMH:
             limit = kmh / 3.6
@@ -168,8 +168,7 @@ def main() -> None:
     metres = " / ".join(f"{d:.0f}" for d in STANDSTILL_M)
     print(f"\n| policy | standing {metres} m before a red line: Q(0) | Q(+1) - Q(0) |")
     print("|---|---|---|")
-    for path in args.policies:
-        policy = QPolicy.load(path)
+    for path, policy in policies.items():
         values = standstill(policy, int(Command.parse(policy.card["mode"])), 50 / 3.6)
         stay = " / ".join(f"{q:.1f}" for q, _ in values)
         creep = " / ".join(f"{dq:.1f}" for _, dq in values)
