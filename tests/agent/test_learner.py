@@ -30,6 +30,35 @@ def test_network_normalises_raw_observations_itself() -> None:
         DuelingQNetwork((0,))
 
 
+def test_near_range_features_read_each_distance_by_hand() -> None:
+    net = DuelingQNetwork((1,), near_range_m=10.0)
+    assert net.trunk[0].in_features == 11  # 8 scaled components, then d_lead, d_tl, d_cross
+    with torch.no_grad():
+        for p in net.parameters():
+            p.zero_()
+        net.trunk[0].weight[0, 9] = 1.0  # d_tl's feature
+        net.value.weight.fill_(1.0)
+    raw = np.array([[1, 0.0, 13.9, 10.0, 0.0, 10.0, 2, 200.0]], dtype=np.float32)
+    # Q = value = relu(exp(-10 / 10)) = 0.367879 for every action (no advantage)
+    q = net(torch.from_numpy(raw)).detach().numpy()
+    assert q == pytest.approx(np.full((1, 7), 0.367879), abs=1e-6)
+    raw[0, 5] = 5.0  # half the range: exp(-0.5) = 0.606531
+    assert net(torch.from_numpy(raw))[0, 0].item() == pytest.approx(0.606531, abs=1e-6)
+    with torch.no_grad():
+        net.trunk[0].weight[0, 9] = 0.0
+        net.trunk[0].weight[0, 10] = 1.0  # d_cross's: exp(-200 / 10) = 2.1e-9, nothing seen
+    assert net(torch.from_numpy(raw))[0, 0].item() == pytest.approx(2.06e-9, rel=1e-2)
+    with pytest.raises(ValueError, match="near_range_m"):
+        DuelingQNetwork((4,), near_range_m=0.0)
+
+
+def test_learner_builds_the_network_the_config_names() -> None:
+    assert D3QNLearner(PAPER.replace(hidden_sizes=[4])).q.trunk[0].in_features == 8
+    learner = D3QNLearner(PAPER.replace(hidden_sizes=[4], near_range_m=15.0))
+    assert learner.q.near_range_m == learner.q_target.near_range_m == 15.0
+    assert learner.q.trunk[0].in_features == 11
+
+
 def test_soft_and_hard_target_updates() -> None:
     learner = D3QNLearner(PAPER.replace(hidden_sizes=[4]))
     with torch.no_grad():

@@ -115,6 +115,8 @@ def test_resume_refuses_a_mismatched_or_corrupt_checkpoint(tmp_path: Path) -> No
     with pytest.raises(CheckpointError, match=r"hidden_sizes.*") as err:
         train(tiny(episodes=4, hidden_sizes=[8]), tmp_path, env_factory=FACTORY, resume=True)
     assert str(ckpt) in str(err.value)
+    with pytest.raises(CheckpointError, match=r"near_range_m: checkpoint None vs run 10\.0"):
+        train(tiny(episodes=4, near_range_m=10.0), tmp_path, env_factory=FACTORY, resume=True)
     ckpt.write_bytes(b"not a checkpoint")
     with pytest.raises(CheckpointError, match="is not an explaindrive checkpoint file") as err:
         train(tiny(episodes=4), tmp_path, env_factory=FACTORY, resume=True)
@@ -141,6 +143,12 @@ def test_subprocess_envs_collect_in_parallel(tmp_path: Path) -> None:
     assert (result.episodes, result.env_steps) == (4, 80)
     assert sorted(int(r["episode"]) for r in rows(tmp_path)) == [0, 1, 2, 3]
     assert {int(r["env"]) for r in rows(tmp_path)} == {0, 1}
+
+
+def test_a_run_with_near_range_features_ships_them(tmp_path: Path) -> None:
+    train(tiny(episodes=2, near_range_m=10.0), tmp_path, env_factory=FACTORY)
+    net = QPolicy.load(tmp_path / "policy.pt").network
+    assert net.near_range_m == 10.0 and net.trunk[0].in_features == 11
 
 
 def test_episodes_that_cannot_start_get_a_new_seed(tmp_path: Path) -> None:

@@ -42,7 +42,7 @@ CONFIG_FILE = "config.json"
 POLICY_FILE = "policy.pt"  # a training run's final policy, its card next to it
 # Fields a resumed run must share with its checkpoint; the others (episodes, logging...)
 # may change between runs.
-STRUCTURAL_FIELDS: tuple[str, ...] = ("mode", "hidden_sizes", "buffer_size")
+STRUCTURAL_FIELDS: tuple[str, ...] = ("mode", "hidden_sizes", "near_range_m", "buffer_size")
 
 
 class CheckpointError(RuntimeError):
@@ -182,6 +182,7 @@ def save_policy(path: Path, network: DuelingQNetwork, card: dict[str, Any]) -> t
         "hidden_sizes": list(network.hidden_sizes),
         "state_dim": network.state_dim,
         "n_actions": network.n_actions,
+        "near_range_m": network.near_range_m,
         "state_dict": network.state_dict(),
     }
     buf = io.BytesIO()
@@ -210,7 +211,12 @@ def load_policy(path: Path) -> tuple[DuelingQNetwork, dict[str, Any]]:
     if payload.get("format") != POLICY_FORMAT:
         raise CheckpointError(f"{path} is not an explaindrive policy file")
     try:
-        net = DuelingQNetwork(payload["hidden_sizes"], payload["state_dim"], payload["n_actions"])
+        net = DuelingQNetwork(
+            payload["hidden_sizes"],
+            payload["state_dim"],
+            payload["n_actions"],
+            payload.get("near_range_m"),  # absent from files saved before the option
+        )
         net.load_state_dict(payload["state_dict"])
     except (KeyError, RuntimeError, ValueError) as exc:
         raise CheckpointError(f"policy file {path} does not hold a valid network: {exc}") from exc

@@ -74,6 +74,10 @@ class TrainConfig(ConfigModel, ScenarioFields):
 
     hidden_sizes: Annotated[tuple[PositiveInt, ...], FROM_LIST, Field(min_length=1)] = (128, 128)
     """Widths of the shared fully connected layers (the paper: two of 128)."""
+    near_range_m: PositiveFloat | None = None
+    """If set, the network also reads exp(-d / near_range_m) of each of the three distances
+    (:class:`~explaindrive.agent.network.DuelingQNetwork`): a fine input near a leader or a
+    stop line; ``None``: the 8 scaled components alone (the paper)."""
     lr: PositiveFloat = 1e-3
     """Adam learning rate (the paper: 1e-3)."""
     lr_final: PositiveFloat | None = None
