@@ -152,6 +152,27 @@ def test_config_file_then_overrides(tmp_path: Path) -> None:
         build_config("safe", tmp_path / "missing.yaml")
 
 
+def test_a_mode_gets_its_own_settings_before_file_and_overrides(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from explaindrive.agent import config
+
+    settings = {"passenger": {"comfort": {"noisy_share": 0.0, "n_step_cut": True}}}
+    monkeypatch.setattr(config, "MODE_SETTINGS", settings)
+    comfort = preset("passenger", "comfort")
+    assert (comfort.mode, comfort.noisy_share, comfort.n_step_cut) == ("comfort", 0.0, True)
+    assert preset("passenger", "fast") == preset("passenger")  # fast: the preset itself
+    assert preset("safe", "comfort") == preset("safe").replace(mode="comfort")
+    c = build_config("passenger", None, {"mode": "comfort", "noisy_share": 0.25})
+    assert (c.noisy_share, c.n_step_cut) == (0.25, True)  # an override wins
+    f = tmp_path / "c.yaml"
+    f.write_text("mode: comfort\n")
+    assert build_config("passenger", f) == comfort  # the mode named in a file counts too
+    assert build_config("passenger", f, {"mode": "fast"}) == preset("passenger")
+    with pytest.raises(ConfigError, match="mode"):
+        build_config("passenger", None, {"mode": ["comfort"]})
+
+
 def test_json_round_trip() -> None:
     c = preset("safe").replace(num_envs=3, lr_final=None)
     assert TrainConfig.from_dict(json.loads(c.to_json())) == c
@@ -205,8 +226,7 @@ def test_shipped_cards_load_exactly(name: str) -> None:
     # the same JSON, down to integers staying integers and floats floats
     assert c.to_json() == json.dumps(saved, indent=2, sort_keys=True)
     # the shipped networks are the passenger preset's, with their own seed
-    assert c == preset("passenger").replace(
-        mode=name,
+    assert c == preset("passenger", name).replace(
         num_envs=saved["num_envs"],
         seed=saved["seed"],
         episodes=1200,

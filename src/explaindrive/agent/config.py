@@ -327,19 +327,27 @@ episodes, the paper's road in a quarter of the draws and generated ones in the r
 PRESETS: dict[str, TrainConfig] = {"paper": PAPER, "safe": SAFE, "passenger": PASSENGER}
 DEFAULT_PRESET = "passenger"
 
+MODE_SETTINGS: dict[str, dict[str, dict[str, Any]]] = {"passenger": {"fast": {}, "comfort": {}}}
+"""Per preset and mode, the settings a preset's fast or comfort network is trained with
+besides the preset's own."""
 
-def preset(name: str) -> TrainConfig:
-    """The named preset.
+
+def preset(name: str, mode: str | None = None) -> TrainConfig:
+    """The named preset; with ``mode``, for that mode: its :data:`MODE_SETTINGS` applied.
 
     Raises:
-        ConfigError: if ``name`` is not a preset.
+        ConfigError: if ``name`` is not a preset or ``mode`` not a mode.
     """
     try:
-        return PRESETS[name]
+        base = PRESETS[name]
     except KeyError:
         raise ConfigError(
             f"unknown preset {name!r}; expected one of: {', '.join(PRESETS)}"
         ) from None
+    if mode is None:
+        return base
+    settings = MODE_SETTINGS.get(name, {}).get(mode, {}) if isinstance(mode, str) else {}
+    return base.replace(mode=mode, **settings)
 
 
 def load_config_file(path: str | Path) -> dict[str, Any]:
@@ -390,13 +398,14 @@ def build_config(
     config_file: str | Path | None = None,
     overrides: Mapping[str, Any] | None = None,
 ) -> TrainConfig:
-    """Preset, then file, then explicit overrides (later wins).
+    """Preset (for the mode the file or the overrides name, else the preset's), then file,
+    then explicit overrides (later wins).
 
     Raises:
-        ConfigError: on an unknown preset, key or an invalid value.
+        ConfigError: on an unknown preset, mode, key or an invalid value.
     """
-    data = preset(preset_name).to_dict()
-    if config_file is not None:
-        data.update(load_config_file(config_file))
-    data.update(overrides or {})
+    chosen = load_config_file(config_file) if config_file is not None else {}
+    chosen.update(overrides or {})
+    data = preset(preset_name, chosen.get("mode", preset(preset_name).mode)).to_dict()
+    data.update(chosen)
     return TrainConfig.from_dict(data)
