@@ -322,14 +322,21 @@ networks' budget), the unsafe-action loss also on synthetic rows near the safety
 a quarter of its weight (:mod:`explaindrive.agent.boundary`), observation noise up to 3 m /
 0.9 m/s drawn in half of the episodes, every episode trained (no early end: a run that is
 safe early still has to learn to drive well), on the scenario family: a new scenario every 20
-episodes, the paper's road in a quarter of the draws and generated ones in the rest."""
+episodes, the paper's road in a quarter of the draws and generated ones in the rest. Its
+comfort network has settings of its own (:data:`MODE_SETTINGS`)."""
 
 PRESETS: dict[str, TrainConfig] = {"paper": PAPER, "safe": SAFE, "passenger": PASSENGER}
 DEFAULT_PRESET = "passenger"
 
-MODE_SETTINGS: dict[str, dict[str, dict[str, Any]]] = {"passenger": {"fast": {}, "comfort": {}}}
+MODE_SETTINGS: dict[str, dict[str, dict[str, Any]]] = {
+    "passenger": {
+        "comfort": {"n_step_cut": True, "speed_noisy_share": 1.0, "near_range_m": 15.0},
+    },
+}
 """Per preset and mode, the settings a preset's fast or comfort network is trained with
-besides the preset's own."""
+besides the preset's own. ``passenger``'s comfort network: returns cut at exploration
+(Watkins), noise on the speeds in every episode (on the distances in half, as the preset),
+and the near-range distance features."""
 
 
 def preset(name: str, mode: str | None = None) -> TrainConfig:
