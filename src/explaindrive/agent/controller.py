@@ -17,9 +17,11 @@ import numpy as np
 import torch
 
 from explaindrive.agent.checkpoint import CheckpointError, load_policy, policy_file
+from explaindrive.agent.estimator import SpeedEstimator
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
+from explaindrive.env.actions import speed_change
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.env.metrics import stop_latency_bound
 from explaindrive.env.state import CMD, STATE_DIM, V_EGO
@@ -96,6 +98,10 @@ class MergedController:
             would have), ``steps`` the actions chosen, ``last_override`` tells whether
             the last action was such a step and ``last_network_action`` is what the network
             chose in it.
+
+    Call :meth:`begin` when a ride starts: under a noisy speed sensor the controller then
+    drives on its estimate of its own speed (:class:`~explaindrive.agent.estimator.SpeedEstimator`),
+    which the shield reads too; without it, on the readings.
     """
 
     def __init__(
@@ -114,7 +120,15 @@ class MergedController:
         self.last_override = False
         self.last_network_action: int | None = None
         self._stop_steps_left: int | None = None  # under STOP: steps left to a standstill
+        self.estimator: SpeedEstimator | None = None
+        self._last_change: int | None = None
         self.set_command(command)
+
+    def begin(self, speed_noise_sd_mps: float = 0.0) -> None:
+        """A ride starts, at a standstill, with a speed sensor of this noise [m/s]: from now
+        on the controller estimates its speed from the readings and its own actions."""
+        self.estimator = SpeedEstimator(speed_noise_sd_mps)
+        self._last_change = None
 
     @property
     def yellow_leader(self) -> str:
@@ -190,6 +204,8 @@ class MergedController:
     def act(self, obs: np.ndarray) -> int:
         """Action of the active agent for a raw observation under the current command."""
         x = self.observation(obs)
+        if self.estimator is not None:
+            x[V_EGO] = self.estimator.update(float(x[V_EGO]), self._last_change)
         steps_left = None
         if self.command is Command.STOP:
             if self._stop_steps_left is None:  # the first step under this STOP
@@ -202,7 +218,9 @@ class MergedController:
         self.last_network_action = int(np.argmax(q_values))
         self.last_override = decision.overridden
         self.overrides += int(decision.overridden)
-        return decision.action if self.use_shield else self.last_network_action
+        action = decision.action if self.use_shield else self.last_network_action
+        self._last_change = speed_change(action)
+        return action
 
 
 def _policy_path(name: str, override: str | Path | None) -> Path:

@@ -27,11 +27,14 @@ import torch
 
 from explaindrive.agent.buffer import Transition
 from explaindrive.agent.config import TrainConfig
+from explaindrive.agent.estimator import SpeedEstimator
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.schedule import EpisodePlan, plan_episode
 from explaindrive.agent.shield import limit_mask, training_mask
+from explaindrive.env.actions import speed_change
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
+from explaindrive.env.state import V_EGO
 from explaindrive.sim.scenario.layout import SEED_LIMIT
 
 log = logging.getLogger(__name__)
@@ -233,6 +236,7 @@ class _Running:
     obs: np.ndarray
     mask: np.ndarray  # the safe actions of obs for learning (training_mask)
     allowed: np.ndarray  # the actions the run-time shield keeps in obs
+    estimator: SpeedEstimator | None  # the speed seen is the estimate (``speed_estimate``)
 
 
 class RolloutWorker:
@@ -290,6 +294,9 @@ class RolloutWorker:
                 continue
             obs = np.asarray(obs, dtype=np.float32)
             true_obs = _true_state(obs, info)
+            estimator = SpeedEstimator(plan.obs_noise[1]) if c.speed_estimate else None
+            if estimator is not None:
+                obs[V_EGO] = estimator.update(float(obs[V_EGO]), None)
             shielded = c.safe_learning and plan.index < c.shielded_fraction * c.episodes
             summary = EpisodeSummary(
                 plan.index, plan.seed, plan.traffic_level, plan.has_stops, shielded
@@ -297,7 +304,7 @@ class RolloutWorker:
             return _Running(
                 plan, summary, NStepQueue(c.n_step, c.gamma, c.n_step_cut),
                 np.random.default_rng([c.seed, 3, plan.index]), obs,
-                learning_mask(obs, true_obs, c.dilemma_braking), _allowed(info),
+                learning_mask(obs, true_obs, c.dilemma_braking), _allowed(info), estimator,
             )  # fmt: skip
         raise RuntimeError(
             f"worker {self.worker_id}: episode {plan.index} failed to start "
@@ -317,6 +324,8 @@ class RolloutWorker:
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         next_obs = np.asarray(next_obs, dtype=np.float32)
         next_true = _true_state(next_obs, info)
+        if ep.estimator is not None:
+            next_obs[V_EGO] = ep.estimator.update(float(next_obs[V_EGO]), speed_change(action))
         next_mask = learning_mask(next_obs, next_true, self.config.dilemma_braking)
         done = bool(terminated or truncated)
         out.transitions += ep.queue.push(

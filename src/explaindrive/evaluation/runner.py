@@ -111,6 +111,8 @@ def run_episode(spec: EpisodeSpec) -> EpisodeRecord:
                 "command_schedule": [list(item) for item in spec.schedule],
             },
         )
+        if driver is not None:
+            driver.begin(config.obs_noise[1])
         done = False
         while not done:
             action = _decide(policy, driver, env, obs)
