@@ -175,3 +175,41 @@ def test_overrides_are_counted_with_and_without_the_shield(tmp_path: Path) -> No
         assert ctrl.act(OBS) == 6 and not ctrl.last_override  # 8 m/s: +3 is fine
         assert ctrl.act(fast) == expected and ctrl.last_override
         assert (ctrl.steps, ctrl.overrides, ctrl.last_network_action) == (2, 1, 6)
+
+
+class _Seen(QPolicy):
+    """A constant +1 m/s policy that records the speed it is shown."""
+
+    def __init__(self, inner: QPolicy) -> None:
+        super().__init__(inner.network, inner.card)
+        self.speeds: list[float] = []
+
+    def q_values(self, obs: np.ndarray) -> np.ndarray:
+        self.speeds.append(round(float(obs[1]), 6))
+        return super().q_values(obs)
+
+
+def test_after_begin_the_networks_see_the_speed_estimate(tmp_path: Path) -> None:
+    """Under 0.6 m/s of speed noise the controller drives on its estimate (gain by hand:
+    0.0025 / (0.0025 + 0.36) = 0.0068966); before begin() on the readings."""
+    seen = _Seen(QPolicy.load(constant_policy(tmp_path, "up", 4)))  # always +1 m/s
+    ctrl = MergedController(seen, seen, use_shield=False)
+    readings = (0.5, 1.6, 1.4)
+    for reading in readings:
+        obs = OBS.copy()
+        obs[1] = reading
+        ctrl.act(obs)
+    assert seen.speeds == [0.5, 1.6, 1.4]
+    seen.speeds.clear()
+    ctrl.begin(0.6)  # a ride starts at rest
+    for reading in readings:
+        obs = OBS.copy()
+        obs[1] = reading
+        ctrl.act(obs)
+    first = 1.0 + 0.0068966 * 0.6
+    assert seen.speeds[0] == 0.0 and seen.speeds[1] == pytest.approx(first, abs=1e-5)
+    assert seen.speeds[2] > first + 0.99  # +1 again, pulled down a little by 1.4
+    ctrl.begin(0.0)  # a noise-free sensor: the readings again
+    seen.speeds.clear()
+    ctrl.act(OBS)
+    assert seen.speeds == [5.0]

@@ -15,9 +15,12 @@ import pytest
 import torch
 
 from explaindrive.agent.config import preset
+from explaindrive.agent.estimator import SpeedEstimator
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.rollout import CollectRequest, RolloutWorker
+from explaindrive.agent.schedule import plan_episode
 from explaindrive.agent.workers import InProcessPool, ProcessPool, make_pool
+from explaindrive.env.actions import speed_change
 from tests.agent.fake_drive_env import FakeDriveEnv
 
 CONFIG = preset("safe").replace(hidden_sizes=[8], n_step=3, num_envs=2, episodes=10)
@@ -136,6 +139,42 @@ def test_the_learning_mask_is_computed_on_the_true_state() -> None:
     for obs, *_, mask, next_mask in rollout.transitions:
         assert obs[5] == 200.0  # the network learns from what it sees...
         assert mask.sum() == next_mask.sum() == 4  # ...and the masks from the true state
+
+
+class _NoisySpeedometer(FakeDriveEnv):
+    """Starts at rest and reads its speed through noise of 0.5 m/s; keeps the readings."""
+
+    def reset(self, *, seed=None, options=None):  # type: ignore[no-untyped-def]
+        obs, info = super().reset(seed=seed, options=options)
+        self.v, self.readings = 0.0, []
+        return self._read(self._obs()), {**info, "true_obs": self._obs()}
+
+    def step(self, action: int):  # type: ignore[no-untyped-def]
+        obs, reward, terminated, truncated, info = super().step(action)
+        return self._read(obs), reward, terminated, truncated, {**info, "true_obs": obs}
+
+    def _read(self, obs: np.ndarray) -> np.ndarray:
+        seen = obs.copy()
+        seen[1] = max(0.0, obs[1] + 0.5 * self.np_random.standard_normal())
+        self.readings.append(float(seen[1]))
+        return seen
+
+
+def test_with_speed_estimate_the_network_learns_from_the_controller_s_estimate() -> None:
+    config = CONFIG.replace(speed_estimate=True, obs_noise_max=(0.0, 0.9), noisy_share=1.0)
+    sd = plan_episode(config, 0).obs_noise[1]
+    assert sd > 0.0
+    worker = RolloutWorker(config, functools.partial(_NoisySpeedometer, max_steps=5), 0)
+    rollout = worker.collect(CollectRequest(steps=5, epsilon=0.5, weights=_weights(), start=0))
+    est, change, expected = SpeedEstimator(sd), None, []
+    for reading, transition in zip(worker.env.readings, rollout.transitions, strict=False):
+        expected.append(est.update(reading, change))
+        change = speed_change(transition.action)
+    assert len(expected) == 5 and expected[0] == 0.0
+    assert [float(t.obs[1]) for t in rollout.transitions] == pytest.approx(expected, abs=1e-6)
+    assert [float(t.obs[1]) for t in rollout.transitions] != pytest.approx(
+        worker.env.readings[:5], abs=1e-3
+    )
 
 
 _KILLED_PARENT = """

@@ -165,3 +165,42 @@ def test_a_network_is_evaluated_with_the_yellow_rule_it_was_trained_with(
         with pytest.raises(_BuiltError):
             run_episode(spec)
     assert rules == ["always", "decided"]
+
+
+def test_a_network_drives_on_its_speed_estimate_under_the_episode_s_noise(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from explaindrive.agent.controller import MergedController
+    from explaindrive.commands import Command
+
+    began: list[float] = []
+    real_begin = MergedController.begin
+
+    def begin(self, speed_noise_sd_mps: float = 0.0) -> None:  # type: ignore[no-untyped-def]
+        began.append(speed_noise_sd_mps)
+        real_begin(self, speed_noise_sd_mps)
+
+    class ProbeEnv:
+        command = Command.FAST
+
+        def __init__(self, config):  # type: ignore[no-untyped-def]
+            self.config = config
+
+        def reset(self, seed, options):  # type: ignore[no-untyped-def]
+            return [0, 0.4, 13.9, 200.0, 0.0, 200.0, 0, 200.0], {}
+
+        def step(self, action):  # type: ignore[no-untyped-def]
+            raise _BuiltError
+
+        def close(self) -> None:
+            pass
+
+    monkeypatch.setattr(MergedController, "begin", begin)
+    monkeypatch.setattr("explaindrive.env.urban_drive.UrbanDriveEnv", ProbeEnv)
+    path = constant_policy(tmp_path / "p.pt", action_index(0), {"mode": "fast"})
+    for noise in ((0.0, 0.0), (2.0, 0.6)):
+        spec = plan_run(parse_policy(str(path)), [0], [1.0], max_steps=MAX_STEPS,
+                        obs_noise=noise).episodes[0]  # fmt: skip
+        with pytest.raises(_BuiltError):
+            run_episode(spec)
+    assert began == [0.0, 0.6]

@@ -32,6 +32,10 @@ class ScriptedController:
         self.use_shield = False
         self.last_override = False
         self.last_network_action: int | None = None
+        self.speed_noise_sd_mps: float | None = None  # set when a ride begins
+
+    def begin(self, speed_noise_sd_mps: float = 0.0) -> None:
+        self.speed_noise_sd_mps = speed_noise_sd_mps
 
     def set_command(self, command: Command | str) -> None:
         cmd = Command.parse(command)

@@ -206,6 +206,16 @@ def test_the_ride_drives_in_the_networks_yellow_rule(rule):
         session.env.close()
 
 
+def test_a_ride_begins_the_controller_with_its_speed_sensor_s_noise():
+    session = make_session(obs_noise=(1.0, 0.3), max_steps=3)
+    try:
+        assert session.controller.speed_noise_sd_mps is None
+        session.start()
+        assert session.controller.speed_noise_sd_mps == 0.3
+    finally:
+        session.close()
+
+
 class OverriddenEveryThirdStep(ScriptedController):
     """Pretends the shield replaced a +3 m/s choice of the network every third step."""
 
