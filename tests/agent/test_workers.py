@@ -145,7 +145,7 @@ class _NoisySpeedometer(FakeDriveEnv):
     """Starts at rest and reads its speed through noise of 0.5 m/s; keeps the readings."""
 
     def reset(self, *, seed=None, options=None):  # type: ignore[no-untyped-def]
-        obs, info = super().reset(seed=seed, options=options)
+        _, info = super().reset(seed=seed, options=options)
         self.v, self.readings = 0.0, []
         return self._read(self._obs()), {**info, "true_obs": self._obs()}
 
