@@ -7,8 +7,9 @@ For every collision, red-light run or pedestrian-yield violation it prints the l
 ``--before`` steps: the time and the ego's route position, the observation, the
 network's speed change, and the actions that the learning mask (the shipped recipe's)
 and the run-time shield allow (one digit per action, -3 ... +3 m/s). With ``--obs-noise``
-the network sees a noisy observation, as ``explaindrive evaluate --obs-noise`` has it; each
-step then shows the true state on a second line.
+the network sees a noisy observation, as ``explaindrive evaluate --obs-noise`` has it (a
+network trained on the speed estimate sees the estimate in place of the speed reading, and
+the row shows it); each step then shows the true state on a second line.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from explaindrive.commands import Command
 from explaindrive.env.actions import speed_change
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.noise import parse_noise
-from explaindrive.env.state import STATE_NAMES
+from explaindrive.env.state import STATE_NAMES, V_EGO
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.parsing import parse_stop_schedule, stops_to_schedule
 
@@ -66,6 +67,7 @@ def main() -> None:
         options={"command": command.label, "traffic_level": args.traffic,
                  "command_schedule": [list(item) for item in schedule]},
     )  # fmt: skip
+    driver.begin(noise.sd_mps)  # the speed estimate, as in `evaluate`
     print("time pos_m", *STATE_NAMES, "change", "learning", "shield", sep="\t")
     recent: deque[str] = deque(maxlen=args.before)
     done, events, steps = False, 0, 0
@@ -73,10 +75,13 @@ def main() -> None:
         while not done:
             driver.set_command(env.command)
             action = int(driver.act(obs))
+            seen = driver.observation(obs)
+            if driver.estimator is not None and agent.speed_estimate:
+                seen[V_EGO] = driver.estimator.speed_mps or 0.0  # the estimate it acted on
             cells = [f"{env.time_s:.0f}s {env.route_pos_m:.1f}"]
-            cells += [f"{x:.1f}" for x in obs]
-            cells += [f"{speed_change(action):+d}", _bits(training_mask(obs)),
-                      _bits(runtime_mask(obs))]  # fmt: skip
+            cells += [f"{x:.1f}" for x in seen]
+            cells += [f"{speed_change(action):+d}", _bits(training_mask(seen)),
+                      _bits(runtime_mask(seen))]  # fmt: skip
             if "true_obs" in info:
                 cells += ["\n  true\t", *(f"{x:.1f}" for x in info["true_obs"])]
             recent.append("\t".join(cells))

@@ -189,10 +189,11 @@ class _Seen(QPolicy):
         return super().q_values(obs)
 
 
-def test_after_begin_the_networks_see_the_speed_estimate(tmp_path: Path) -> None:
+def test_after_begin_a_network_trained_on_the_estimate_sees_it(tmp_path: Path) -> None:
     """Under 0.6 m/s of speed noise the controller drives on its estimate (gain by hand:
     0.0025 / (0.0025 + 0.36) = 0.0068966); before begin() on the readings."""
-    seen = _Seen(QPolicy.load(constant_policy(tmp_path, "up", 4)))  # always +1 m/s
+    card = {"mode": "fast", "config": {"speed_estimate": True}}
+    seen = _Seen(QPolicy.load(helpers.constant_policy(tmp_path / "up.pt", 4, card)))  # +1 m/s
     ctrl = MergedController(seen, seen, use_shield=False)
     readings = (0.5, 1.6, 1.4)
     for reading in readings:
@@ -213,3 +214,20 @@ def test_after_begin_the_networks_see_the_speed_estimate(tmp_path: Path) -> None
     seen.speeds.clear()
     ctrl.act(OBS)
     assert seen.speeds == [5.0]
+
+
+def test_a_network_trained_on_the_readings_keeps_them(tmp_path: Path) -> None:
+    plain = _Seen(QPolicy.load(constant_policy(tmp_path, "plain", 4)))  # a card without it
+    card = {"mode": "comfort", "config": {"speed_estimate": True}}
+    estimating = _Seen(QPolicy.load(helpers.constant_policy(tmp_path / "e.pt", 4, card)))
+    assert not plain.speed_estimate and estimating.speed_estimate
+    ctrl = MergedController(plain, estimating, use_shield=False)
+    ctrl.begin(0.6)
+    for reading, command in ((0.5, "fast"), (1.6, "fast"), (2.4, "comfort")):
+        ctrl.set_command(command)
+        obs = OBS.copy()
+        obs[1] = reading
+        ctrl.act(obs)
+    # the estimate runs under both: +1, +1 from rest -> about 2 m/s when comfort takes over
+    assert plain.speeds == [0.5, 1.6]
+    assert estimating.speeds[0] == pytest.approx(2.0, abs=0.02)

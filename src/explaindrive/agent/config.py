@@ -186,9 +186,10 @@ class TrainConfig(ConfigModel, ScenarioFields):
     distances' (which keep ``noisy_share``); ``None``: the speeds are noisy in the episodes
     whose distances are."""
     speed_estimate: bool = False
-    """Whether the network sees, in noisy episodes, the speed the run-time controller drives
-    on: the reading fused with its own speed changes
-    (:class:`~explaindrive.agent.estimator.SpeedEstimator`), not the reading."""
+    """Whether the network sees, in noisy episodes, the controller's estimate of its speed:
+    the reading fused with its own speed changes
+    (:class:`~explaindrive.agent.estimator.SpeedEstimator`), not the reading. The run-time
+    controller then shows it the estimate too."""
     boundary_weight: NonNegativeFloat = 0.0
     """Weight of the unsafe-action loss on one synthetic observation per minibatch row, moved
     near the safety boundary (:mod:`explaindrive.agent.boundary`; ``safe_learning``); 0

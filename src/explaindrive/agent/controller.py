@@ -72,6 +72,12 @@ class QPolicy:
         return int(np.argmax(self.q_values(obs)))
 
     @property
+    def speed_estimate(self) -> bool:
+        """Whether the network was trained on the controller's speed estimate (its card's
+        ``config.speed_estimate``; a card without it: on the speed readings)."""
+        return bool(self.card.get("config", {}).get("speed_estimate", False))
+
+    @property
     def yellow_leader(self) -> str:
         """The environment's rule for yellow lights the network was trained with (its card's
         ``config.yellow_leader``; a card without it predates the field: the default)."""
@@ -100,8 +106,9 @@ class MergedController:
             chose in it.
 
     Call :meth:`begin` when a ride starts: under a noisy speed sensor the controller then
-    drives on its estimate of its own speed (:class:`~explaindrive.agent.estimator.SpeedEstimator`),
-    which the shield reads too; without it, on the readings.
+    estimates its own speed (:class:`~explaindrive.agent.estimator.SpeedEstimator`), and a
+    network trained on that estimate (:attr:`QPolicy.speed_estimate`) and its shield read it
+    in place of the speed reading; the others read the readings they were trained on.
     """
 
     def __init__(
@@ -126,7 +133,8 @@ class MergedController:
 
     def begin(self, speed_noise_sd_mps: float = 0.0) -> None:
         """A ride starts, at a standstill, with a speed sensor of this noise [m/s]: from now
-        on the controller estimates its speed from the readings and its own actions."""
+        on the controller estimates its speed from the readings and its own actions, for the
+        networks trained on that estimate."""
         self.estimator = SpeedEstimator(speed_noise_sd_mps)
         self._last_change = None
 
@@ -204,8 +212,10 @@ class MergedController:
     def act(self, obs: np.ndarray) -> int:
         """Action of the active agent for a raw observation under the current command."""
         x = self.observation(obs)
-        if self.estimator is not None:
-            x[V_EGO] = self.estimator.update(float(x[V_EGO]), self._last_change)
+        if self.estimator is not None:  # tracks the speed whichever network drives
+            estimate = self.estimator.update(float(x[V_EGO]), self._last_change)
+            if self.policy.speed_estimate:
+                x[V_EGO] = estimate
         steps_left = None
         if self.command is Command.STOP:
             if self._stop_steps_left is None:  # the first step under this STOP
