@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from explaindrive.agent.estimator import GATE_SD, SpeedEstimator
+from explaindrive.agent.estimator import GATE_SD, SpeedEstimator, settled_sd
 
 
 def test_without_noise_the_estimate_is_the_reading() -> None:
@@ -57,6 +57,7 @@ def test_the_estimate_s_deviation_settles_where_the_riccati_equation_puts_it(
     for _ in range(500):
         est.update(est.speed_mps or 0.0, 0)
     assert math.sqrt(est.variance) == pytest.approx(settled, abs=5e-4)
+    assert settled_sd(sd) == pytest.approx(settled, abs=5e-4) and settled_sd(0.0) == 0.0
 
 
 def test_on_a_noisy_sensor_the_estimate_is_closer_than_the_readings() -> None:

@@ -90,3 +90,15 @@ class SpeedEstimator:
         self.speed_mps = predicted + gain * innovation
         self.variance = (1.0 - gain) * predicted_var
         return self.speed_mps
+
+
+def settled_sd(sd_mps: float, drift_mps: float = SPEED_DRIFT_MPS) -> float:
+    """[m/s] The standard deviation at which the estimate's error settles on a sensor with
+    noise ``sd_mps`` (the steady state of the filter's Riccati equation: the prediction's
+    variance p = (q + sqrt(q^2 + 4 q r)) / 2 with q = drift^2, r = sd^2, then p r / (p + r)
+    after the reading)."""
+    q, r = drift_mps**2, sd_mps**2
+    if r == 0.0:
+        return 0.0
+    p = (q + math.sqrt(q * q + 4.0 * q * r)) / 2.0
+    return math.sqrt(p * r / (p + r))
