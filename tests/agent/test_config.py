@@ -213,7 +213,7 @@ def _with_added_fields(saved: dict[str, Any]) -> dict[str, Any]:
     return {**{k: v for k, v in ADDED_FIELDS.items() if k not in saved}, **saved}
 
 
-PRESET_CHANGED_SINCE: dict[str, dict[str, Any]] = {"fast": {"boundary_weight": 0.0}, "comfort": {}}
+PRESET_CHANGED_SINCE: dict[str, dict[str, Any]] = {"fast": {}, "comfort": {}}
 """Per shipped card, the passenger preset's settings it was trained before (with their value
 on the card)."""
 

@@ -335,13 +335,21 @@ DEFAULT_PRESET = "passenger"
 
 MODE_SETTINGS: dict[str, dict[str, dict[str, Any]]] = {
     "passenger": {
+        "fast": {
+            "n_step_cut": True,
+            "speed_noisy_share": 1.0,
+            "near_range_m": 15.0,
+            "speed_estimate": True,
+            "unsafe_loss_weight": 4.0,
+        },
         "comfort": {"n_step_cut": True, "speed_noisy_share": 1.0, "near_range_m": 15.0},
     },
 }
 """Per preset and mode, the settings a preset's fast or comfort network is trained with
-besides the preset's own. ``passenger``'s comfort network: returns cut at exploration
-(Watkins), noise on the speeds in every episode (on the distances in half, as the preset),
-and the near-range distance features."""
+besides the preset's own. ``passenger``'s networks: returns cut at exploration (Watkins),
+noise on the speeds in every episode (on the distances in half, as the preset), and the
+near-range distance features; fast's also sees the controller's speed estimate in place of
+the speed reading, and weighs the unsafe-action loss four times."""
 
 
 def preset(name: str, mode: str | None = None) -> TrainConfig:
