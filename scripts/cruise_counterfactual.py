@@ -12,6 +12,13 @@ own command; the script prints both returns and the terms that differ by more th
 
 A higher return for the forced cruise on most episodes says the network's values, not its
 reward, keep it slow: its value of the faster speed is too low.
+
+With ``--approach`` the second run forces a later braking instead: approaching a red or
+yellow light that is its leader (no vehicle closer), where the network would slow down, the
+car keeps its speed if it could still stand :data:`APPROACH_STANDSTILL_M` before the line
+after one more step at that speed, braking at ``--approach`` m/s^2 (the free bound of the
+passenger reward's approach term: 1.5), and the safety rule allows keeping it. A higher
+return then says the values, not the reward, make it brake early.
 """
 
 from __future__ import annotations
@@ -25,8 +32,9 @@ import numpy as np
 
 from explaindrive.agent.controller import QPolicy
 from explaindrive.env import state as S
-from explaindrive.env.actions import action_index, speed_change
+from explaindrive.env.actions import IDLE_ACTION, action_index, speed_change
 from explaindrive.env.config import EnvConfig
+from explaindrive.env.reward import APPROACH_STANDSTILL_M
 from explaindrive.env.ride_quality import is_free_road
 from explaindrive.env.safety import safe_action_mask
 from explaindrive.env.urban_drive import UrbanDriveEnv
@@ -35,8 +43,25 @@ from explaindrive.evaluation.parsing import parse_levels, parse_seeds
 ACCELERATE = action_index(1)
 
 
+def holds_for_light(obs: np.ndarray, decel_mps2: float) -> bool:
+    """Whether, approaching a red or yellow light that is its leader, the car could keep its
+    speed one more step and still stand :data:`APPROACH_STANDSTILL_M` before the line braking
+    at ``decel_mps2``."""
+    v, d_tl = float(obs[S.V_EGO]), float(obs[S.D_TL])
+    light_ahead = obs[S.TLS] != 0 and d_tl < S.SENSOR_RANGE_M
+    light_leads = abs(float(obs[S.D_LEAD]) - d_tl) < 0.5
+    return bool(
+        light_ahead and light_leads and v > 0
+        and v * v / (2.0 * decel_mps2) <= d_tl - v - APPROACH_STANDSTILL_M
+    )  # fmt: skip
+
+
 def episode(
-    policy: QPolicy, seed: int, traffic: float, below: float | None
+    policy: QPolicy,
+    seed: int,
+    traffic: float,
+    below: float | None,
+    approach: float | None = None,
 ) -> tuple[float, int, int, dict[str, float]]:
     """One episode: its return, steps, forced steps and the sum of each reward term."""
     mode = str(policy.card["mode"])
@@ -58,6 +83,13 @@ def episode(
                 highest = math.floor(float(obs[S.V_LIM]) + 1e-9)
                 if obs[S.V_EGO] < highest - below - 1e-6 and safe_action_mask(obs)[ACCELERATE]:
                     action, forced = ACCELERATE, forced + 1
+            if (
+                approach is not None
+                and speed_change(action) < 0
+                and holds_for_light(obs, approach)
+                and safe_action_mask(obs)[IDLE_ACTION]
+            ):
+                action, forced = IDLE_ACTION, forced + 1
             obs, reward, terminated, truncated, info = env.step(action)
             done = terminated or truncated
             free = is_free_road(info)
@@ -82,8 +114,15 @@ def main() -> None:
     parser.add_argument(
         "--below", type=float, default=1.0, help="force +1 while this far under the top speed"
     )
+    parser.add_argument(
+        "--approach",
+        type=float,
+        default=None,
+        help="[m/s^2] force a later braking for lights at this deceleration instead",
+    )
     args = parser.parse_args()
     policy = QPolicy.load(args.policy)
+    below, approach = (None, args.approach) if args.approach is not None else (args.below, None)
     levels = parse_levels(args.traffic)
     print("| seed | traffic | return as is | return forced | forced steps | terms forced - as is |")
     print("|---|---|---|---|---|---|")
@@ -91,12 +130,13 @@ def main() -> None:
     for seed in parse_seeds(args.seeds):
         for traffic in levels:
             as_is = episode(policy, seed, traffic, None)
-            forced = episode(policy, seed, traffic, args.below)
+            forced = episode(policy, seed, traffic, below, approach)
             better, runs = better + int(forced[0] > as_is[0]), runs + 1
             print(f"| {seed} | {traffic} | {as_is[0]:.1f} ({as_is[1]} steps) | "
                   f"{forced[0]:.1f} ({forced[1]} steps) | {forced[2]} | "
                   f"{_differences(forced[3], as_is[3])} |")  # fmt: skip
-    print(f"\nthe forced cruise returns more in {better} of {runs} episodes")
+    what = "later braking" if approach is not None else "cruise"
+    print(f"\nthe forced {what} returns more in {better} of {runs} episodes")
 
 
 if __name__ == "__main__":
