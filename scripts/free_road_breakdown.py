@@ -1,0 +1,116 @@
+"""Where a network's free-road time goes, against SUMO's Krauss on the same episodes.
+
+    python scripts/free_road_breakdown.py src/explaindrive/agent/policies/fast.pt \
+        --seeds 1000-1009 --traffic 0.5,1.0
+
+The free road is the ride figures' (:func:`~explaindrive.env.ride_quality.is_free_road`: no
+vehicle within 50 m, no red or yellow light or busy crossing within 60 m). Each free-road
+step of the bare network and of Krauss falls in one class: cruising at 90 % of the posted
+limit or more, accelerating, slowing down (by more than 0.5 m/s), or steady below 90 %.
+For the network's steady steps below 90 % it then prints the most common contexts: its
+speed and limit, the light within the 200 m sensor range and whether a vehicle is in range.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+from pathlib import Path
+
+from explaindrive.agent.controller import MergedController, QPolicy
+from explaindrive.env.actions import IDLE_ACTION
+from explaindrive.env.config import EnvConfig
+from explaindrive.env.ride_quality import is_free_road
+from explaindrive.env.state import SENSOR_RANGE_M
+from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.evaluation.parsing import parse_levels, parse_seeds
+
+CRUISE_SHARE = 0.9  # of the posted limit
+CHANGE_MPS = 0.5  # a speed change beyond this is accelerating or slowing down
+
+
+def free_road_steps(policy: QPolicy, driver: str, seed: int, traffic: float) -> list[dict]:
+    """The free-road steps of one episode driven by the bare network or by SUMO's ``krauss``:
+    speed, previous speed, posted limit, light in range and leader in range."""
+    mode = str(policy.card["mode"])
+    config = EnvConfig(
+        traffic_level=traffic,
+        ego_model="agent" if driver == "network" else driver,
+        yellow_leader=policy.yellow_leader,
+    )
+    env = UrbanDriveEnv(config=config)
+    controller = MergedController(policy, policy, mode, use_shield=False)
+    steps, previous = [], 0.0
+    try:
+        obs, _ = env.reset(seed=seed, options={"command": mode, "traffic_level": traffic})
+        controller.begin()
+        done = False
+        while not done:
+            controller.follow(env)
+            action = controller.act(obs) if driver == "network" else IDLE_ACTION
+            obs, _, terminated, truncated, info = env.step(action)
+            done = terminated or truncated
+            if is_free_road(info):
+                light = (
+                    f"{info['light_state']} light in range"
+                    if info["light_gap_m"] < SENSOR_RANGE_M
+                    else "no light in range"
+                )
+                leader = "vehicle in range" if info["real_gap_m"] < SENSOR_RANGE_M else "no vehicle"
+                steps.append({"v": info["speed_mps"], "before": previous,
+                              "limit": info["posted_limit_mps"], "light": light,
+                              "leader": leader})  # fmt: skip
+            previous = info["speed_mps"]
+    finally:
+        env.close()
+    return steps
+
+
+def kind(step: dict) -> str:
+    """The class of one free-road step."""
+    if step["v"] >= CRUISE_SHARE * step["limit"]:
+        return "cruise"
+    if step["v"] > step["before"] + CHANGE_MPS:
+        return "accelerating"
+    if step["v"] < step["before"] - CHANGE_MPS:
+        return "slowing"
+    return "steady below 90 %"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("policy", type=Path, help="a policy .pt file")
+    parser.add_argument("--seeds", default="1000-1009", help="e.g. 1000-1009 (validation seeds)")
+    parser.add_argument("--traffic", default="0.5,1.0", help="comma-separated traffic levels")
+    args = parser.parse_args()
+    policy = QPolicy.load(args.policy)
+    kinds = ("cruise", "accelerating", "slowing", "steady below 90 %")
+    print("| driver | free-road steps | mean share of the limit | " + " | ".join(kinds) + " |")
+    print("|---|---|---|" + "---|" * len(kinds))
+    steady: collections.Counter[tuple] = collections.Counter()
+    for driver in ("network", "krauss"):
+        steps = [
+            s
+            for seed in parse_seeds(args.seeds)
+            for traffic in parse_levels(args.traffic)
+            for s in free_road_steps(policy, driver, seed, traffic)
+        ]
+        counts = collections.Counter(kind(s) for s in steps)
+        share = sum(s["v"] / s["limit"] for s in steps) / max(len(steps), 1)
+        cells = " | ".join(f"{100 * counts[k] / max(len(steps), 1):.1f} %" for k in kinds)
+        print(f"| {driver} | {len(steps)} | {share:.3f} | {cells} |")
+        if driver == "network":
+            steady.update(
+                (round(s["v"]), round(s["limit"], 1), s["light"], s["leader"])
+                for s in steps
+                if kind(s) == "steady below 90 %"
+            )
+    print("\nThe network's steady free-road steps below 90 % of the limit, by context:\n")
+    print("| speed m/s | limit m/s | light | vehicle | steps |")
+    print("|---|---|---|---|---|")
+    for (v, limit, light, leader), n in steady.most_common(8):
+        print(f"| {v} | {limit} | {light} | {leader} | {n} |")
+
+
+if __name__ == "__main__":
+    main()
