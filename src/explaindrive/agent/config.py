@@ -333,16 +333,16 @@ comfort network has settings of its own (:data:`MODE_SETTINGS`)."""
 PRESETS: dict[str, TrainConfig] = {"paper": PAPER, "safe": SAFE, "passenger": PASSENGER}
 DEFAULT_PRESET = "passenger"
 
+_PASSENGER_NETWORKS: dict[str, Any] = {
+    "n_step_cut": True,
+    "speed_noisy_share": 1.0,
+    "near_range_m": 15.0,
+}
+
 MODE_SETTINGS: dict[str, dict[str, dict[str, Any]]] = {
     "passenger": {
-        "fast": {
-            "n_step_cut": True,
-            "speed_noisy_share": 1.0,
-            "near_range_m": 15.0,
-            "speed_estimate": True,
-            "unsafe_loss_weight": 4.0,
-        },
-        "comfort": {"n_step_cut": True, "speed_noisy_share": 1.0, "near_range_m": 15.0},
+        "fast": {**_PASSENGER_NETWORKS, "speed_estimate": True, "unsafe_loss_weight": 4.0},
+        "comfort": dict(_PASSENGER_NETWORKS),
     },
 }
 """Per preset and mode, the settings a preset's fast or comfort network is trained with
