@@ -234,3 +234,15 @@ def test_the_real_env_factory_builds_the_presets_yellow_rule(name: str, rule: st
         assert (env.config.yellow_leader, env.config.max_steps) == (rule, 50)  # type: ignore[attr-defined]
     finally:
         env.close()
+
+
+def test_the_real_env_factory_passes_the_stop_window_to_the_reward() -> None:
+    from explaindrive.agent.rollout import default_env_factory
+
+    config = preset("passenger", "comfort").replace(max_episode_steps=50, stop_window_m=(1, 4))
+    env = default_env_factory(config)()
+    try:
+        assert env.recipe.comfort.stop_window_m == (1.0, 4.0)  # type: ignore[attr-defined]
+        assert env.recipe.comfort.cruise == 5.0  # type: ignore[attr-defined]
+    finally:
+        env.close()

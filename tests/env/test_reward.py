@@ -222,6 +222,25 @@ def test_standing_for_a_signal_pays_only_near_the_line(gap_m, paper, passenger):
     assert t.total == pytest.approx(passenger - 0.5)  # and the charge for time
 
 
+@pytest.mark.parametrize(("gap_m", "paid"), [(4.5, 0.0), (4.0, 2.0), (1.0, 2.0), (0.9, 0.0)])
+def test_a_stop_window_replaces_the_recipes_under_both_commands(gap_m, paid):
+    recipe = R.PASSENGER_RECIPE.with_stop_window((1, 4))
+    assert recipe.fast.stop_window_m == recipe.comfort.stop_window_m == (1.0, 4.0)
+    assert recipe.comfort.cruise == R.PASSENGER_RECIPE.comfort.cruise  # nothing else moves
+    f = _features(
+        speed_mps=0.0, speed_change_mps=-1, ttc_s=math.inf, headway_s=math.inf, jerk_mps3=0.0,
+        stop_reason="signal", leader_gap_m=gap_m,
+    )  # fmt: skip
+    for command in (Command.FAST, Command.COMFORT):
+        assert R.reward_terms(command, f, recipe).traffic == paid
+
+
+@pytest.mark.parametrize("window", [(4.0, 1.0), (2.0, 2.0), (-1.0, 3.0), (1.0, math.inf)])
+def test_a_stop_window_must_be_ordered_and_finite(window):
+    with pytest.raises(ValueError, match="0 <= min < max"):
+        R.PASSENGER_RECIPE.with_stop_window(window)
+
+
 def test_a_stop_pays_less_than_driving_at_the_limit():
     for w in (R.PASSENGER_RECIPE.fast, R.PASSENGER_RECIPE.comfort):
         assert w.signal_stop - w.time < w.speed - w.time

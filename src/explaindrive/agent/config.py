@@ -41,7 +41,7 @@ from explaindrive.env.curriculum import SCHEDULE_HORIZON_S, STOP_DURATION_S, STO
 from explaindrive.env.curriculum import SEED_POOL_BASE as SEED_POOL_BASE  # re-exported
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
 from explaindrive.env.noise import NoiseSD
-from explaindrive.env.reward import REWARD_NAMES
+from explaindrive.env.reward import REWARD_NAMES, StopWindow
 from explaindrive.sim.scenario.choice import ScenarioFields
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
@@ -175,6 +175,10 @@ class TrainConfig(ConfigModel, ScenarioFields):
     reward: Annotated[str, one_of(REWARD_NAMES)] = "paper"
     """The reward recipe (:mod:`explaindrive.env.reward`): ``paper`` (R0/R1/R2) or
     ``passenger`` (the same terms, weighted for a ride a passenger would choose)."""
+    stop_window_m: StopWindow | None = None
+    """``(min, max)`` metres before the line within which the reward pays standing for a
+    light or a pedestrian; ``None``: the recipe's own
+    (:attr:`~explaindrive.env.reward.RewardWeights.stop_window_m`)."""
     obs_noise_max: NoiseSD = (0.0, 0.0)
     """``(sd_m, sd_mps)``: a share ``noisy_share`` of the episodes draws its observation noise
     uniformly between 0 and these (domain randomisation, :mod:`explaindrive.env.noise`);

@@ -56,13 +56,19 @@ def make_urban_drive_env(
     yellow_leader: str = DEFAULT_YELLOW_LEADER,
     scenario: Mapping[str, Any] | None = None,
     reward: str = "paper",
+    stop_window_m: tuple[float, float] | None = None,
 ) -> gym.Env:
     """The project's SUMO environment (imported lazily: each worker builds its own) in the
     ``scenario`` chosen by these env config fields (the paper's road by default)."""
     from explaindrive.env.config import EnvConfig
     from explaindrive.env.urban_drive import UrbanDriveEnv
 
-    config = EnvConfig(yellow_leader=yellow_leader, reward=reward, **dict(scenario or {}))
+    config = EnvConfig(
+        yellow_leader=yellow_leader,
+        reward=reward,
+        stop_window_m=stop_window_m,
+        **dict(scenario or {}),
+    )
     return UrbanDriveEnv(
         config=config if max_steps is None else config.replace(max_steps=max_steps)
     )
@@ -76,6 +82,7 @@ def default_env_factory(config: TrainConfig) -> EnvFactory:
         config.yellow_leader,
         config.scenario_fields(),
         config.reward,
+        config.stop_window_m,
     )
 
 

@@ -11,7 +11,7 @@ from explaindrive import limits
 from explaindrive.config import ConfigModel, TextPath, TrafficLevel, one_of
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER, YELLOW_LEADERS
 from explaindrive.env.noise import NoiseSD, ObservationNoise
-from explaindrive.env.reward import REWARD_NAMES
+from explaindrive.env.reward import REWARD_NAMES, StopWindow
 from explaindrive.sim.scenario.choice import ScenarioFields
 
 EGO_MODELS: tuple[str, ...] = ("agent", "krauss", "idm")
@@ -43,6 +43,8 @@ class EnvConfig(ConfigModel, ScenarioFields):
         obs_noise: ``(sd_m, sd_mps)`` of the Gaussian noise on the observed distances and
             speeds (:mod:`explaindrive.env.noise`); violations and rewards are judged on
             the true state, which ``info["true_obs"]`` holds when noise is on.
+        stop_window_m: ``(min, max)`` metres before the line within which the reward pays
+            standing for a light or a pedestrian; ``None``: the recipe's own.
     """
 
     config_name = "env config"
@@ -57,6 +59,7 @@ class EnvConfig(ConfigModel, ScenarioFields):
     yellow_leader: Annotated[str, one_of(YELLOW_LEADERS)] = DEFAULT_YELLOW_LEADER
     reward: Annotated[str, one_of(REWARD_NAMES)] = "paper"
     obs_noise: NoiseSD = Field(default=(0.0, 0.0))
+    stop_window_m: StopWindow | None = None
 
     @property
     def noise(self) -> ObservationNoise:

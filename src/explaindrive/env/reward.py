@@ -31,9 +31,13 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
+from typing import Annotated
+
+from pydantic import AfterValidator
 
 from explaindrive.commands import Command
+from explaindrive.config import FROM_LIST
 
 R_RESPECT = 2.0  # reward for stopping at a red light / for a pedestrian
 R_UNSAFE = 10.0  # penalty for violations, speeding and stopping without reason
@@ -114,6 +118,32 @@ class RewardRecipe:
             raise ValueError("the stop reward R2 has no weights")
         return self.fast if command is Command.FAST else self.comfort
 
+    def with_stop_window(self, window_m: tuple[float, float]) -> RewardRecipe:
+        """This recipe with standing for a light or a pedestrian paid within ``window_m``
+        of the line under both commands (:attr:`RewardWeights.stop_window_m`).
+
+        Raises:
+            ValueError: unless ``0 <= min < max``.
+        """
+        lo, hi = check_stop_window(window_m)
+        return replace(
+            self,
+            fast=replace(self.fast, stop_window_m=(lo, hi)),
+            comfort=replace(self.comfort, stop_window_m=(lo, hi)),
+        )
+
+
+def check_stop_window(window_m: tuple[float, float]) -> tuple[float, float]:
+    """``window_m`` as floats if ``0 <= min < max`` (metres before the line).
+
+    Raises:
+        ValueError: otherwise.
+    """
+    lo, hi = (float(x) for x in window_m)
+    if not (math.isfinite(hi) and 0.0 <= lo < hi):
+        raise ValueError(f"a stop window must be [min, max] m with 0 <= min < max, got {[lo, hi]}")
+    return lo, hi
+
 
 PAPER_RECIPE = RewardRecipe(
     "paper",
@@ -153,6 +183,8 @@ PASSENGER_RECIPE = RewardRecipe(
         stop_window_m=STOP_WINDOW_M,
     ),
 )
+StopWindow = Annotated[tuple[float, float], FROM_LIST, AfterValidator(check_stop_window)]
+"""A config field holding ``(min_m, max_m)`` before a stop line, ``0 <= min < max``."""
 RECIPES: dict[str, RewardRecipe] = {r.name: r for r in (PAPER_RECIPE, PASSENGER_RECIPE)}
 REWARD_NAMES: tuple[str, ...] = tuple(RECIPES)
 

@@ -87,6 +87,10 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         else:
             cfg = EnvConfig.from_mapping({**dict(config or {}), **overrides})
         self.config = cfg
+        recipe = RECIPES[cfg.reward]
+        self.recipe = (
+            recipe if cfg.stop_window_m is None else recipe.with_stop_window(cfg.stop_window_m)
+        )
         self.render_mode = render_mode
         self._scenarios = ScenarioSource(
             cfg.cache_dir or user_cache_dir(), cfg.scenario, cfg.net_file, cfg.route,
@@ -276,7 +280,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     # ------------------------------------------------------------------ step pieces
     def _reward(self, command: Command, features: StepFeatures) -> RewardTerms:
         """A step's reward terms under ``command``, the one its action was taken in."""
-        return reward_terms(command, features, RECIPES[self.config.reward])
+        return reward_terms(command, features, self.recipe)
 
     def _is_terminated(self, motion: Motion) -> bool:
         """The episode ends in a terminal state: the ego collided or reached its route's end."""
