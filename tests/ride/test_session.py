@@ -8,6 +8,7 @@ import time
 import pytest
 
 from explaindrive.commands import Command
+from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
 from explaindrive.ride.runner import run_ride
@@ -212,6 +213,19 @@ def test_a_ride_begins_the_controller_with_its_speed_sensor_s_noise():
         assert session.controller.speed_noise_sd_mps is None
         session.start()
         assert session.controller.speed_noise_sd_mps == 0.3
+    finally:
+        session.close()
+
+
+def test_a_ride_on_an_env_of_its_own_begins_with_that_env_s_noise():
+    env = UrbanDriveEnv(traffic_level=0.5, max_steps=3, obs_noise=(2.0, 0.6))
+    session = RideSession(
+        RideConfig(traffic_level=0.5, seed=3, max_steps=3), ScriptedController(),
+        fake_language(), env=env,
+    )  # fmt: skip
+    try:
+        session.start()
+        assert session.controller.speed_noise_sd_mps == 0.6  # not the ride config's 0
     finally:
         session.close()
 

@@ -96,7 +96,7 @@ class RideSession:
     def start(self, command: Command = Command.FAST) -> NDArray[np.float32]:
         """Reset the environment; the ride starts under ``command``."""
         obs, _ = self.env.reset(seed=self.config.seed, options={"command": command.label})
-        self.controller.begin(self.config.obs_noise[1])
+        self.controller.begin(self.env.config.obs_noise[1])  # the sensor it drives with
         self.controller.follow(self.env)
         self._obs = obs
         self.done = False
