@@ -210,6 +210,7 @@ def test_after_begin_a_network_trained_on_the_estimate_sees_it(tmp_path: Path) -
     first = 1.0 + 0.0068966 * 0.6
     assert seen.speeds[0] == 0.0 and seen.speeds[1] == pytest.approx(first, abs=1e-5)
     assert seen.speeds[2] > first + 0.99  # +1 again, pulled down a little by 1.4
+    assert ctrl.last_seen is not None and ctrl.last_seen[1] == pytest.approx(seen.speeds[2])
     ctrl.begin(0.0)  # a noise-free sensor: the readings again
     seen.speeds.clear()
     ctrl.act(OBS)

@@ -33,6 +33,7 @@ class ScriptedController:
         self.last_override = False
         self.last_network_action: int | None = None
         self.speed_noise_sd_mps: float | None = None  # set when a ride begins
+        self.last_seen: np.ndarray | None = None
 
     def begin(self, speed_noise_sd_mps: float = 0.0) -> None:
         self.speed_noise_sd_mps = speed_noise_sd_mps
@@ -52,6 +53,7 @@ class ScriptedController:
         return x
 
     def act(self, obs: np.ndarray) -> int:
+        self.last_seen = obs
         return self.driver(obs)
 
 

@@ -217,6 +217,30 @@ def test_a_ride_begins_the_controller_with_its_speed_sensor_s_noise():
         session.close()
 
 
+class EstimatingController(ScriptedController):
+    """Reads its speed as 1.25 m/s whatever the sensor says, as a speed estimate would."""
+
+    def act(self, obs):  # type: ignore[no-untyped-def]
+        action = super().act(obs)
+        self.last_seen = obs.copy()
+        self.last_seen[1] = 1.25
+        return action
+
+
+def test_the_log_and_the_explanations_hold_what_the_network_read():
+    session = RideSession(
+        RideConfig(traffic_level=0.5, seed=3, max_steps=4), EstimatingController(),
+        fake_language(),
+    )  # fmt: skip
+    try:
+        session.start()
+        records = [session.step() for _ in range(4)]
+    finally:
+        session.close()
+    assert [r.state["v_ego"] for r in records] == [1.25] * 4
+    assert [r.speed_mps for r in records] != [1.25] * 4  # the true speed stays apart
+
+
 def test_a_ride_on_an_env_of_its_own_begins_with_that_env_s_noise():
     env = UrbanDriveEnv(traffic_level=0.5, max_steps=3, obs_noise=(2.0, 0.6))
     session = RideSession(

@@ -126,6 +126,9 @@ class MergedController:
         self.steps = 0
         self.last_override = False
         self.last_network_action: int | None = None
+        self.last_seen: np.ndarray | None = None
+        """The observation the active network and its shield read in the last step: the
+        speed estimate in place of the reading for a network trained on it."""
         self._stop_steps_left: int | None = None  # under STOP: steps left to a standstill
         self.estimator: SpeedEstimator | None = None
         self._last_change: int | None = None
@@ -216,6 +219,7 @@ class MergedController:
             estimate = self.estimator.update(float(x[V_EGO]), self._last_change)
             if self.policy.speed_estimate:
                 x[V_EGO] = estimate
+        self.last_seen = x
         steps_left = None
         if self.command is Command.STOP:
             if self._stop_steps_left is None:  # the first step under this STOP

@@ -179,13 +179,16 @@ class RideSession:
         t0 = time.perf_counter()
         action = self.controller.act(obs)
         policy_s = time.perf_counter() - t0
+        seen = self.controller.last_seen  # what the network read: explained and logged
+        if seen is None:
+            seen = obs
         command, agent = self.controller.command, self.controller.active_agent
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         self.metrics.update(info, reward)
         change = speed_change(action)
         record = StepRecord(
             t=float(info["time_s"]),
-            state={n: round(float(v), 3) for n, v in zip(S.STATE_NAMES, obs, strict=True)},
+            state={n: round(float(v), 3) for n, v in zip(S.STATE_NAMES, seen, strict=True)},
             command=command.label,
             agent=agent.label,
             action=change,
@@ -205,7 +208,7 @@ class RideSession:
         self._obs = next_obs
         self.done = terminated or truncated
         if command is not Command.STOP or change > 0:
-            self.explanations.submit_decision(record, StateRecord.from_observation(obs, change))
+            self.explanations.submit_decision(record, StateRecord.from_observation(seen, change))
         if self.done:
             self._handle(self.lane.collect(wait=True))
             record.passenger.extend(self._inbox)
