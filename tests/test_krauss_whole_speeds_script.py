@@ -2,21 +2,15 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 from types import ModuleType
 
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "krauss_whole_speeds.py"
+from .helpers import load_script
 
 
 def _script() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("krauss_whole_speeds", SCRIPT)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("krauss_whole_speeds")
 
 
 def test_the_default_factor_is_13_mps_at_50_kmh() -> None:

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 from types import ModuleType, SimpleNamespace
 
 import pytest
@@ -12,15 +10,11 @@ import torch
 from explaindrive.env import state as S
 from explaindrive.env.actions import action_index
 
-SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "probe_policy.py"
+from .helpers import load_script
 
 
 def _probe() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("probe_policy", SCRIPT)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("probe_policy")
 
 
 def _threshold(below: float) -> SimpleNamespace:
