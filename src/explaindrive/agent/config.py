@@ -341,19 +341,21 @@ _PASSENGER_NETWORKS: dict[str, Any] = {
     "n_step_cut": True,
     "speed_noisy_share": 1.0,
     "near_range_m": 15.0,
+    "speed_estimate": True,
 }
 
 MODE_SETTINGS: dict[str, dict[str, dict[str, Any]]] = {
     "passenger": {
-        "fast": {**_PASSENGER_NETWORKS, "speed_estimate": True, "unsafe_loss_weight": 4.0},
-        "comfort": dict(_PASSENGER_NETWORKS),
+        "fast": {**_PASSENGER_NETWORKS, "unsafe_loss_weight": 4.0},
+        "comfort": {**_PASSENGER_NETWORKS, "stop_window_m": (1.0, 4.0)},
     },
 }
 """Per preset and mode, the settings a preset's fast or comfort network is trained with
 besides the preset's own. ``passenger``'s networks: returns cut at exploration (Watkins),
-noise on the speeds in every episode (on the distances in half, as the preset), and the
-near-range distance features; fast's also sees the controller's speed estimate in place of
-the speed reading, and weighs the unsafe-action loss four times."""
+noise on the speeds in every episode (on the distances in half, as the preset), the
+near-range distance features, and the controller's speed estimate in place of the speed
+reading; fast weighs the unsafe-action loss four times, and comfort is paid for standing
+only within 1-4 m of the line (a metre inside the ride target's 1-5 m)."""
 
 
 def preset(name: str, mode: str | None = None) -> TrainConfig:
