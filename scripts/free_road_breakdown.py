@@ -20,12 +20,12 @@ from pathlib import Path
 from explaindrive.agent.controller import MergedController, QPolicy
 from explaindrive.env.actions import IDLE_ACTION
 from explaindrive.env.config import EnvConfig
+from explaindrive.env.reward import CRUISE_SHARE
 from explaindrive.env.ride_quality import is_free_road
 from explaindrive.env.state import SENSOR_RANGE_M
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.parsing import parse_levels, parse_seeds
 
-CRUISE_SHARE = 0.9  # of the posted limit
 CHANGE_MPS = 0.5  # a speed change beyond this is accelerating or slowing down
 
 

@@ -22,7 +22,7 @@ from explaindrive.env.config import EnvConfig
 from explaindrive.env.metrics import EpisodeMetrics, EpisodeResult
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.aggregate import aggregate
-from explaindrive.evaluation.parsing import parse_seeds
+from explaindrive.evaluation.parsing import SpecError, parse_levels, parse_seeds
 from explaindrive.sim.scenario.files import EGO_ID
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
@@ -47,14 +47,15 @@ def krauss_episode(seed: int, traffic: float, factor: float | None) -> EpisodeRe
     return metrics.result()
 
 
-def _row(name: str, results: list[EpisodeResult]) -> tuple[str, float, float]:
+def _row(name: str, results: list[EpisodeResult]) -> tuple[float, float]:
+    """Print one table row; returns the mean speed and the mean travel time."""
     a = aggregate(results)
     travel = statistics.fmean(r.travel_time_s for r in results)
     print(
         f"| {name} | {a.mean_speed_mps:.3f} | {travel:.1f} | {a.hard_brakes_per_episode:.2f} "
         f"| {100 * (a.slow_free_road_share or 0.0):.1f} % | {a.light_stop_gap_mean_m or 0:.1f} |"
     )
-    return name, a.mean_speed_mps, travel
+    return a.mean_speed_mps, travel
 
 
 def main() -> None:
@@ -66,7 +67,10 @@ def main() -> None:
     args = parser.parse_args()
     if not 0.0 < args.factor <= 2.0:
         parser.error(f"--factor must lie in (0, 2], got {args.factor}")
-    grid = [(s, float(t)) for s in parse_seeds(args.seeds) for t in args.traffic.split(",")]
+    try:
+        grid = [(s, t) for s in parse_seeds(args.seeds) for t in parse_levels(args.traffic)]
+    except SpecError as exc:
+        parser.error(str(exc))
     with ProcessPoolExecutor(args.workers) as pool:
         free = list(pool.map(krauss_episode, *zip(*grid, strict=True), [None] * len(grid)))
         held = list(pool.map(krauss_episode, *zip(*grid, strict=True), [args.factor] * len(grid)))
@@ -74,8 +78,8 @@ def main() -> None:
     print("| Krauss | mean speed m/s | travel time s | hard brakes /episode "
           "| free road < 60 % | standstill at lights m |")  # fmt: skip
     print("|---|---|---|---|---|---|")
-    _, v0, t0 = _row("as it is", free)
-    _, v1, t1 = _row(f"speed factor {args.factor:.3f}", held)
+    v0, t0 = _row("as it is", free)
+    v1, t1 = _row(f"speed factor {args.factor:.3f}", held)
     print(f"\nmean speed ratio {v1 / v0:.3f}; travel time +{t1 - t0:.1f} s an episode")
 
 
