@@ -1,14 +1,17 @@
 """Where a network's free-road time goes, against SUMO's Krauss on the same episodes.
 
     python scripts/free_road_breakdown.py src/explaindrive/agent/policies/fast.pt \
-        --seeds 1000-1009 --traffic 0.5,1.0
+        --seeds 1000-1009 --traffic 0.5,1.0 [--scenarios random:100-119]
 
 The free road is the ride figures' (:func:`~explaindrive.env.ride_quality.is_free_road`: no
 vehicle within 50 m, no red or yellow light or busy crossing within 60 m). Each free-road
 step of the bare network and of Krauss falls in one class: cruising at 90 % of the posted
 limit or more, accelerating, slowing down (by more than 0.5 m/s), or steady below 90 %.
-For the network's steady steps below 90 % it then prints the most common contexts: its
-speed and limit, the light within the 200 m sensor range and whether a vehicle is in range.
+The free-road steps below 60 % of the limit (the ride figures' slow free road) are split
+the same way. For the network's steady steps below 90 % it then prints the most common
+contexts: its speed and limit, the light within the 200 m sensor range and whether a vehicle
+is in range. ``--scenarios`` drives generated scenarios held out from training instead of
+the paper's road.
 """
 
 from __future__ import annotations
@@ -18,22 +21,28 @@ import collections
 from pathlib import Path
 
 from explaindrive.agent.controller import MergedController, QPolicy
+from explaindrive.cache import cache_dir
 from explaindrive.env.actions import IDLE_ACTION
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.reward import CRUISE_SHARE
-from explaindrive.env.ride_quality import is_free_road
+from explaindrive.env.ride_quality import SLOW_SHARE, is_free_road
 from explaindrive.env.state import SENSOR_RANGE_M
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.parsing import parse_levels, parse_seeds
+from explaindrive.evaluation.scenarios import ScenarioCase, parse_scenarios
 
 CHANGE_MPS = 0.5  # a speed change beyond this is accelerating or slowing down
 
 
-def free_road_steps(policy: QPolicy, driver: str, seed: int, traffic: float) -> list[dict]:
+def free_road_steps(
+    policy: QPolicy, driver: str, seed: int, traffic: float, where: ScenarioCase | None = None
+) -> list[dict]:
     """The free-road steps of one episode driven by the bare network or by SUMO's ``krauss``:
-    speed, previous speed, posted limit, light in range and leader in range."""
+    speed, previous speed, posted limit, light in range and leader in range. ``where``: a
+    scenario of the family (the paper's road if ``None``)."""
     mode = str(policy.card["mode"])
     config = EnvConfig(
+        **dict(where.fields if where else ()),
         traffic_level=traffic,
         ego_model="agent" if driver == "network" else driver,
         yellow_leader=policy.yellow_leader,
@@ -82,23 +91,30 @@ def main() -> None:
     parser.add_argument("policy", type=Path, help="a policy .pt file")
     parser.add_argument("--seeds", default="1000-1009", help="e.g. 1000-1009 (validation seeds)")
     parser.add_argument("--traffic", default="0.5,1.0", help="comma-separated traffic levels")
+    parser.add_argument("--scenarios", help="generated scenarios, e.g. random:100-119")
     args = parser.parse_args()
     policy = QPolicy.load(args.policy)
+    wheres = parse_scenarios(args.scenarios, cache_dir()) if args.scenarios else (None,)
     kinds = ("cruise", "accelerating", "slowing", "steady below 90 %")
-    print("| driver | free-road steps | mean share of the limit | " + " | ".join(kinds) + " |")
-    print("|---|---|---|" + "---|" * len(kinds))
+    slow_kinds = kinds[1:]
+    print("| driver | free-road steps | mean share of the limit | " + " | ".join(kinds)
+          + " | below 60 %: " + " | ".join(slow_kinds) + " |")  # fmt: skip
+    print("|---|---|---|" + "---|" * (len(kinds) + len(slow_kinds)))
     steady: collections.Counter[tuple] = collections.Counter()
     for driver in ("network", "krauss"):
         steps = [
             s
+            for where in wheres
             for seed in parse_seeds(args.seeds)
             for traffic in parse_levels(args.traffic)
-            for s in free_road_steps(policy, driver, seed, traffic)
+            for s in free_road_steps(policy, driver, seed, traffic, where)
         ]
         counts = collections.Counter(kind(s) for s in steps)
+        slow = collections.Counter(kind(s) for s in steps if s["v"] < SLOW_SHARE * s["limit"])
         share = sum(s["v"] / s["limit"] for s in steps) / max(len(steps), 1)
         cells = " | ".join(f"{100 * counts[k] / max(len(steps), 1):.1f} %" for k in kinds)
-        print(f"| {driver} | {len(steps)} | {share:.3f} | {cells} |")
+        slow_cells = " | ".join(f"{100 * slow[k] / max(len(steps), 1):.1f} %" for k in slow_kinds)
+        print(f"| {driver} | {len(steps)} | {share:.3f} | {cells} | {slow_cells} |")
         if driver == "network":
             steady.update(
                 (round(s["v"]), round(s["limit"], 1), s["light"], s["leader"])
