@@ -1,5 +1,5 @@
-"""One observation's mask (its components as numpy scalars, the speed's outcomes kept) is
-its row of the batch mask, over random and edge-case observations."""
+"""One observation's mask (the rule in plain Python, the speed's outcomes kept) is its row of
+the batch mask (the rule vectorised), over random and edge-case observations."""
 
 from __future__ import annotations
 

@@ -1,8 +1,7 @@
 """A kinematic safety shield: the best-valued action that keeps a stopping option.
 
-Which actions are safe is the rule of :mod:`explaindrive.env.safety`, written once and
-vectorised over a batch of raw observations (the environment reports the same mask); it is
-re-exported here, and the scalar helpers index it. At run time (:func:`shield`) braking in
+Which actions are safe is the rule of :mod:`explaindrive.env.safety` (the environment
+reports the same mask); it is re-exported here, and the scalar helpers index it. At run time (:func:`shield`) braking in
 a yellow light's dilemma zone is unsafe; the training mask leaves it allowed. Under STOP the
 shield also keeps the stop within its latency bound (ceil(v/3) + 2 steps from the command);
 the training mask asks instead that every step under STOP brings the standstill one

@@ -17,15 +17,19 @@ red. :func:`runtime_mask` (the shield's rule) forbids braking there; :func:`trai
 it. Under STOP both ask that every step brings the standstill one hardest-braking step
 closer.
 
-Every rule is written once, vectorised over a batch of raw observations
-(:func:`safe_action_mask`); one observation runs the same rule on its components as numpy
-scalars, with what the actions do at its speed (:class:`ActionOutcomes`) kept per speed. The
-environment reports :func:`runtime_mask` of the true state as ``info["action_mask"]``;
-:mod:`explaindrive.agent.shield` builds the run-time shield on these rules.
+The rule is written vectorised over a batch of raw observations (:func:`_unsafe`, what
+learning's targets use) and, for the one observation the environment and the shield check
+every step, in plain Python (:func:`_unsafe_one`: numpy's per-call overhead is most of the
+cost of one row), with what the actions do at its speed kept per speed.
+tests/env/test_safety.py holds the two to the same answer on random and edge-case
+observations. The environment reports :func:`runtime_mask` of the true state as
+``info["action_mask"]``; :mod:`explaindrive.agent.shield` builds the run-time shield on
+these rules.
 """
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 from typing import Any, NamedTuple
 
@@ -92,16 +96,6 @@ def action_outcomes(speed_mps: NDArray[np.float64] | float) -> ActionOutcomes:
     )
 
 
-@lru_cache(maxsize=SPEEDS_KEPT)
-def _outcomes_at(speed_mps: float) -> ActionOutcomes:
-    """:func:`action_outcomes` of one speed, kept (read-only): one observation's mask reads
-    it, and the speeds of an episode repeat."""
-    outcomes = action_outcomes(speed_mps)
-    for array in outcomes:
-        array.flags.writeable = False
-    return outcomes
-
-
 def safe_action_mask(
     obs: NDArray[np.floating], dilemma_braking: bool = False, stop_progress: bool = False
 ) -> NDArray[np.bool_]:
@@ -119,19 +113,17 @@ def safe_action_mask(
         Boolean mask of shape ``(B, 7)`` (``(7,)`` for one observation). A row may be all
         false: then no action keeps a stopping option (see :func:`training_mask`).
     """
-    columns, outcomes = _columns(obs)
+    x = np.asarray(obs, dtype=np.float64)
+    if x.ndim == 1:
+        unsafe = _unsafe_one(x.reshape(S.STATE_DIM).tolist(), dilemma_braking, stop_progress)
+        return np.array([not u for u in unsafe], dtype=np.bool_)
+    columns, outcomes = _columns(x)
     return ~_unsafe(columns, outcomes, dilemma_braking, stop_progress)
 
 
-def _columns(obs: NDArray[np.floating]) -> tuple[tuple[Any, ...], ActionOutcomes]:
+def _columns(x: NDArray[np.float64]) -> tuple[tuple[Any, ...], ActionOutcomes]:
     """The 8 components of raw observations ``(B, 8)``, each a column ``(B, 1)``, and the
-    :class:`ActionOutcomes` of their speeds; for one observation ``(8,)``, the components as
-    numpy scalars (the same operations as on columns, without the cost of arrays) and its
-    speed's kept outcomes."""
-    x = np.asarray(obs, dtype=np.float64)
-    if x.ndim == 1:
-        row = x.reshape(S.STATE_DIM)
-        return tuple(row), _outcomes_at(float(row[S.V_EGO]))
+    :class:`ActionOutcomes` of their speeds."""
     rows = x.reshape(-1, S.STATE_DIM)
     return tuple(rows.T[:, :, None]), action_outcomes(rows[:, S.V_EGO : S.V_EGO + 1])
 
@@ -139,11 +131,10 @@ def _columns(obs: NDArray[np.floating]) -> tuple[tuple[Any, ...], ActionOutcomes
 def _unsafe(
     columns: tuple[Any, ...], out: ActionOutcomes, dilemma_braking: bool, stop_progress: bool
 ) -> NDArray[np.bool_]:
-    """The rule of :func:`safe_action_mask`: which actions are unsafe.
+    """The rule of :func:`safe_action_mask` over a batch: which actions are unsafe.
 
     Args:
-        columns: the 8 components of the observations, each of shape ``(B, 1)`` (or, for
-            one observation, each a numpy scalar).
+        columns: the 8 components of the observations, each of shape ``(B, 1)``.
         out: the :class:`ActionOutcomes` of their speeds.
         dilemma_braking, stop_progress: as in :func:`safe_action_mask`.
     """
@@ -151,7 +142,7 @@ def _unsafe(
     need = out.need
     unsafe = _over_limit(v_lim, out)
     # Each rule below applies only where its condition holds; where it holds for no
-    # observation the rule is skipped (one observation mostly has few objects in range).
+    # observation the rule is skipped.
     crossing = d_cross < S.SENSOR_RANGE_M
     if _anywhere(crossing):
         unsafe |= crossing & (need > d_cross)
@@ -182,22 +173,84 @@ def _unsafe(
     return unsafe
 
 
-def _anywhere(condition: Any) -> bool:
-    """Whether ``condition`` (a boolean column, or one numpy boolean) holds for any
-    observation; a scalar is tested directly (``ndarray.any`` costs microseconds)."""
-    return bool(condition) if condition.ndim == 0 else bool(condition.any())
+def _anywhere(condition: NDArray[np.bool_]) -> bool:
+    """Whether ``condition`` (a boolean column) holds for any observation."""
+    return bool(condition.any())
 
 
 def _over_limit(v_lim: Any, out: ActionOutcomes) -> NDArray[np.bool_]:
-    """The actions that exceed the posted limit ``v_lim`` (a column, or a scalar); above it,
-    all but the hardest braking. ``out``: the :class:`ActionOutcomes` of the speeds."""
+    """The actions that exceed the posted limit ``v_lim`` (a column); above it, all but the
+    hardest braking. ``out``: the :class:`ActionOutcomes` of the speeds."""
     return (out.v_new > v_lim) & out.eases
+
+
+class _Action(NamedTuple):
+    """:class:`ActionOutcomes` of one action at one speed, as Python values."""
+
+    v_new: float
+    need: float
+    slows: bool
+    keeps: bool
+    closer: bool
+    eases: bool
+
+    def over(self, v_lim: float) -> bool:
+        """It exceeds the posted limit (:func:`_over_limit`)."""
+        return self.v_new > v_lim and self.eases
+
+
+@lru_cache(maxsize=SPEEDS_KEPT)
+def _actions_at(speed_mps: float) -> tuple[tuple[_Action, ...], float]:
+    """The 7 actions' outcomes at one speed and ``least_need``, kept per speed (the speeds
+    of an episode repeat)."""
+    o = action_outcomes(speed_mps)
+    columns = (o.v_new, o.need, o.slows, o.keeps, o.closer, o.eases)
+    actions = tuple(_Action(*row) for row in zip(*(c.tolist() for c in columns), strict=True))
+    return actions, float(o.least_need)
+
+
+def _code(value: float) -> float:
+    """A light or command code rounded as :func:`numpy.rint` does (NaN and inf kept)."""
+    return round(value) if math.isfinite(value) else value
+
+
+def _unsafe_one(values: list[float], dilemma_braking: bool, stop_progress: bool) -> list[bool]:
+    """The rule of :func:`_unsafe` for one observation's 8 components: which actions are
+    unsafe. Standing still after an action needs its ``need`` ahead: the room up to the
+    nearest busy crossing, light to stop for and point where the real leader could stop."""
+    cmd, v, v_lim, gap, dv, d_tl, tls, d_cross = values
+    actions, least_need = _actions_at(v)
+    room = d_cross if d_cross < S.SENSOR_RANGE_M else math.inf
+    tls = _code(tls)
+    signal = tls != 0
+    light = d_tl < S.SENSOR_RANGE_M and signal
+    must_go = light and tls == 1 and not least_need <= d_tl
+    if light and not must_go:
+        room = min(room, d_tl)
+    virtual = (signal and abs(gap - d_tl) <= VIRTUAL_TOL_M) or abs(gap - d_cross) <= VIRTUAL_TOL_M
+    if gap < S.SENSOR_RANGE_M and not virtual:
+        leader_v = max(v - dv, 0.0)
+        room = min(room, gap + float(braking_distances(leader_v, LEADER_BRAKE_MPS)))
+    no_slowing = must_go and not dilemma_braking
+    stopping = stop_progress and _code(cmd) == int(Command.STOP)
+    return [
+        a.over(v_lim)
+        or a.need > room
+        or (no_slowing and a.slows)
+        or (stopping and not (a.closer or (must_go and a.keeps)))
+        for a in actions
+    ]
 
 
 def limit_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
     """The posted-limit rule of :func:`safe_action_mask` alone, for raw observations of shape
     ``(B, 8)`` (or ``(8,)``)."""
-    columns, outcomes = _columns(obs)
+    x = np.asarray(obs, dtype=np.float64)
+    if x.ndim == 1:
+        values = x.reshape(S.STATE_DIM).tolist()
+        actions, _ = _actions_at(values[S.V_EGO])
+        return np.array([not a.over(values[S.V_LIM]) for a in actions], dtype=np.bool_)
+    columns, outcomes = _columns(x)
     return ~_over_limit(columns[S.V_LIM], outcomes)
 
 
