@@ -48,7 +48,7 @@ def next_speed(v_mps: float, action: int) -> float:
 
 
 def braking_distances(
-    speed_mps: NDArray[np.floating], brake_mps: float = MAX_BRAKE_MPS
+    speed_mps: NDArray[np.floating] | float, brake_mps: float = MAX_BRAKE_MPS
 ) -> NDArray[np.float64]:
     """Distances [m] covered after this step when braking by ``brake_mps`` per 1 s step.
 
