@@ -17,12 +17,13 @@ import argparse
 import statistics
 from concurrent.futures import ProcessPoolExecutor
 
-from explaindrive.env.actions import IDLE_ACTION
-from explaindrive.env.config import EnvConfig
-from explaindrive.env.metrics import EpisodeMetrics, EpisodeResult
+from explaindrive.commands import Command
+from explaindrive.env.metrics import EpisodeResult
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.aggregate import aggregate
 from explaindrive.evaluation.parsing import SpecError, parse_levels, parse_seeds
+from explaindrive.evaluation.runner import run_episode
+from explaindrive.evaluation.spec import EpisodeSpec, parse_policy
 from explaindrive.sim.scenario.files import EGO_ID
 from explaindrive.sim.scenario.layout import TRAFFIC_LEVELS
 
@@ -31,20 +32,12 @@ WHOLE_SHARE_50 = 13.0 / (50.0 / 3.6)  # the highest whole speed under 50 km/h, a
 
 def krauss_episode(seed: int, traffic: float, factor: float | None) -> EpisodeResult:
     """One Krauss episode of the paper's road; ``factor`` sets its speed factor."""
-    env = UrbanDriveEnv(config=EnvConfig(traffic_level=traffic, ego_model="krauss"))
-    metrics = EpisodeMetrics()
-    try:
-        env.reset(seed=seed, options={"traffic_level": traffic})
-        if factor is not None:
-            env.sumo.vehicle.setSpeedFactor(EGO_ID, factor)
-        done = False
-        while not done:
-            _obs, reward, terminated, truncated, info = env.step(IDLE_ACTION)
-            metrics.update(info, reward)
-            done = terminated or truncated
-    finally:
-        env.close()
-    return metrics.result()
+    spec = EpisodeSpec(parse_policy("krauss"), seed, traffic, Command.FAST.label, ())
+
+    def hold(env: UrbanDriveEnv) -> None:
+        env.sumo.vehicle.setSpeedFactor(EGO_ID, factor)
+
+    return run_episode(spec, None if factor is None else hold).result
 
 
 def _row(name: str, results: list[EpisodeResult]) -> tuple[float, float]:

@@ -16,7 +16,7 @@ import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -25,6 +25,9 @@ from explaindrive.env.actions import IDLE_ACTION
 from explaindrive.env.metrics import EpisodeMetrics, EpisodeResult
 from explaindrive.evaluation.spec import EpisodeSpec, PolicySpec
 from explaindrive.processes import children_ignore_sigint
+
+if TYPE_CHECKING:
+    from explaindrive.env.urban_drive import UrbanDriveEnv
 
 log = logging.getLogger(__name__)
 
@@ -71,8 +74,13 @@ def _decide(policy: PolicySpec, driver: Any, env: Any, obs: np.ndarray) -> int:
     return int(driver.act(obs))
 
 
-def run_episode(spec: EpisodeSpec) -> EpisodeRecord:
+def run_episode(
+    spec: EpisodeSpec, after_reset: Callable[[UrbanDriveEnv], None] | None = None
+) -> EpisodeRecord:
     """Drive one episode and measure it; the same spec gives the same record.
+
+    ``after_reset(env)`` runs once the ego has entered, before the first step (for example
+    to change the ego's SUMO parameters).
 
     Raises:
         CheckpointError: if a policy file cannot be loaded.
@@ -113,6 +121,8 @@ def run_episode(spec: EpisodeSpec) -> EpisodeRecord:
         )
         if driver is not None:
             driver.begin(config.obs_noise[1])
+        if after_reset is not None:
+            after_reset(env)
         done = False
         while not done:
             action = _decide(policy, driver, env, obs)
