@@ -1,11 +1,12 @@
 """A kinematic safety shield: the best-valued action that keeps a stopping option.
 
 Which actions are safe is the rule of :mod:`explaindrive.env.safety` (the environment
-reports the same mask); it is re-exported here, and the scalar helpers index it. At run time (:func:`shield`) braking in
-a yellow light's dilemma zone is unsafe; the training mask leaves it allowed. Under STOP the
-shield also keeps the stop within its latency bound (ceil(v/3) + 2 steps from the command);
-the training mask asks instead that every step under STOP brings the standstill one
-hardest-braking step closer, which keeps that bound without knowing when the command came.
+reports the same mask); it is re-exported here, and the scalar helpers index it. At run
+time (:func:`shield`) braking in a yellow light's dilemma zone is unsafe; the training mask
+leaves it allowed. Under STOP the shield also keeps the stop within its latency bound
+(ceil(v/3) + 2 steps from the command); the training mask asks instead that every step
+under STOP brings the standstill one hardest-braking step closer, which keeps that bound
+without knowing when the command came.
 """
 
 from __future__ import annotations
