@@ -27,7 +27,7 @@ _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
 _HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
 class Leader:
     """What the ego follows: a vehicle, or a zero-length virtual one at a stop line."""
 
@@ -37,7 +37,7 @@ class Leader:
     virtual: bool
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
 class LightReading:
     """The next light of the ego's route within sensor range.
 
@@ -56,7 +56,7 @@ NO_LIGHT = LightReading()
 """The reading with no light in sensor range."""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
 class CrossingReading:
     """The crossings ahead.
 
@@ -70,7 +70,7 @@ class CrossingReading:
     in_lane: dict[str, bool]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
 class Percept:
     """One step's perception.
 

@@ -56,7 +56,7 @@ class EgoEntry:
     tls_link: dict[str, int]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
 class Motion:
     """Outcome of one simulated step for the ego.
 
