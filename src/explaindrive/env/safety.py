@@ -113,12 +113,27 @@ def safe_action_mask(
         Boolean mask of shape ``(B, 7)`` (``(7,)`` for one observation). A row may be all
         false: then no action keeps a stopping option (see :func:`training_mask`).
     """
-    x = np.asarray(obs, dtype=np.float64)
-    if x.ndim == 1:
-        unsafe = _unsafe_one(x.reshape(S.STATE_DIM).tolist(), dilemma_braking, stop_progress)
-        return np.array([not u for u in unsafe], dtype=np.bool_)
-    columns, outcomes = _columns(x)
-    return ~_unsafe(columns, outcomes, dilemma_braking, stop_progress)
+    return _mask(obs, dilemma_braking, stop_progress, fallback=False)
+
+
+def _mask(
+    obs: NDArray[np.floating], dilemma_braking: bool, stop_progress: bool, fallback: bool
+) -> NDArray[np.bool_]:
+    """:func:`safe_action_mask`; with ``fallback``, rows that allow nothing allow the
+    hardest braking (what the shield does there)."""
+    x = np.asarray(obs)
+    if x.ndim == 1:  # one observation: the rule in plain Python, one numpy call
+        unsafe = _unsafe_one(x.tolist(), dilemma_braking, stop_progress)
+        safe = [not u for u in unsafe]
+        if fallback and not any(safe):
+            safe[HARDEST_BRAKE] = True
+        return np.array(safe, dtype=np.bool_)
+    columns, outcomes = _columns(x.astype(np.float64, copy=False))
+    mask = ~_unsafe(columns, outcomes, dilemma_braking, stop_progress)
+    if fallback:
+        rows = mask.reshape(-1, len(SPEED_CHANGES_MPS))
+        rows[~rows.any(axis=1), HARDEST_BRAKE] = True
+    return mask
 
 
 def _columns(x: NDArray[np.float64]) -> tuple[tuple[Any, ...], ActionOutcomes]:
@@ -245,37 +260,24 @@ def _unsafe_one(values: list[float], dilemma_braking: bool, stop_progress: bool)
 def limit_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
     """The posted-limit rule of :func:`safe_action_mask` alone, for raw observations of shape
     ``(B, 8)`` (or ``(8,)``)."""
-    x = np.asarray(obs, dtype=np.float64)
+    x = np.asarray(obs)
     if x.ndim == 1:
-        values = x.reshape(S.STATE_DIM).tolist()
+        values = x.tolist()
         actions, _ = _actions_at(values[S.V_EGO])
         return np.array([not a.over(values[S.V_LIM]) for a in actions], dtype=np.bool_)
-    columns, outcomes = _columns(x)
+    columns, outcomes = _columns(x.astype(np.float64, copy=False))
     return ~_over_limit(columns[S.V_LIM], outcomes)
-
-
-def _with_fallback(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
-    """Rows that allow nothing allow the hardest braking (what the shield does there)."""
-    if mask.ndim == 1:  # one observation: a scalar test, cheaper than boolean indexing
-        if not np.count_nonzero(mask):
-            mask[HARDEST_BRAKE] = True
-        return mask
-    rows = mask.reshape(-1, len(SPEED_CHANGES_MPS))
-    rows[~rows.any(axis=1), HARDEST_BRAKE] = True
-    return mask
 
 
 def training_mask(obs: NDArray[np.floating], dilemma_braking: bool = True) -> NDArray[np.bool_]:
     """The safety mask learning uses: dilemma braking allowed unless ``dilemma_braking`` is
     false, STOP must make progress, and the hardest braking where nothing is safe (every row
     allows an action)."""
-    return _with_fallback(
-        safe_action_mask(obs, dilemma_braking=dilemma_braking, stop_progress=True)
-    )
+    return _mask(obs, dilemma_braking, stop_progress=True, fallback=True)
 
 
 def runtime_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
     """The actions the run-time shield keeps (dilemma braking forbidden), with STOP's
     progress rule standing in for its latency bound: a greedy action outside this mask is
     one the shield would override."""
-    return _with_fallback(safe_action_mask(obs, stop_progress=True))
+    return _mask(obs, dilemma_braking=False, stop_progress=True, fallback=True)
