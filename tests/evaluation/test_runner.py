@@ -204,3 +204,20 @@ def test_a_network_drives_on_its_speed_estimate_under_the_episode_s_noise(
         with pytest.raises(_BuiltError):
             run_episode(spec)
     assert began == [0.0, 0.6]
+
+
+def test_after_reset_sees_the_env_once_the_ego_has_entered() -> None:
+    from explaindrive.evaluation.spec import EpisodeSpec
+    from explaindrive.sim.scenario.files import EGO_ID
+
+    seen: list[tuple[float, float]] = []
+
+    def hold(env) -> None:  # type: ignore[no-untyped-def]
+        env.sumo.vehicle.setSpeedFactor(EGO_ID, 0.5)
+        seen.append((env.sumo.vehicle.getSpeedFactor(EGO_ID), env.sumo.vehicle.getSpeed(EGO_ID)))
+
+    spec = EpisodeSpec(parse_policy("krauss"), 0, 0.5, "fast", (), max_steps=30)
+    record = run_episode(spec, after_reset=hold)
+    assert seen == [(0.5, 0.0)]  # called once, before the first step: the ego stands at entry
+    # held to half of 50 km/h (6.94 m/s), Krauss never drives faster
+    assert max(record.speeds_mps) <= 0.5 * 50 / 3.6 + 1e-6
