@@ -78,7 +78,7 @@ class Episode:
             self.command = self.schedule.pop(0)[1]
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class StepRecord:
     """Everything one step produced that the reward and the info are computed from.
 

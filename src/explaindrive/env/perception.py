@@ -27,7 +27,7 @@ _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
 _HIGH: tuple[float, ...] = tuple(float(x) for x in S.STATE_HIGH)
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class Leader:
     """What the ego follows: a vehicle, or a zero-length virtual one at a stop line."""
 
@@ -37,7 +37,7 @@ class Leader:
     virtual: bool
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class LightReading:
     """The next light of the ego's route within sensor range.
 
@@ -56,7 +56,7 @@ NO_LIGHT = LightReading()
 """The reading with no light in sensor range."""
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class CrossingReading:
     """The crossings ahead.
 
@@ -70,7 +70,7 @@ class CrossingReading:
     in_lane: dict[str, bool]
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class Percept:
     """One step's perception.
 

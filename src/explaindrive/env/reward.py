@@ -309,7 +309,7 @@ def stop_reward(speed_mps: float, speed_change_mps: int) -> float:
     return 0.0
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class StepFeatures:
     """Everything a reward needs about one step."""
 
@@ -330,7 +330,7 @@ class StepFeatures:
     free_road: bool = False  # as the ride-quality figures define it (env/ride_quality.py)
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class RewardTerms:
     """The terms of one step's reward (all zero when not part of the active reward)."""
 

@@ -56,7 +56,7 @@ class EgoEntry:
     tls_link: dict[str, int]
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class Motion:
     """Outcome of one simulated step for the ego.
 

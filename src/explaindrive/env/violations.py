@@ -27,7 +27,7 @@ def speeding(speed_mps: float, legal_limit_mps: float) -> bool:
     return speed_mps > legal_limit_mps + SPEEDING_TOLERANCE_MPS
 
 
-@dataclass(slots=True)  # built every step: not frozen, whose __init__ costs 5x
+@dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class Violations:
     """The stop-line violations of one step."""
 
