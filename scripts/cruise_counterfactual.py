@@ -1,7 +1,7 @@
 """Would the reward pay for a faster cruise than the network drives? Each episode twice.
 
     python scripts/cruise_counterfactual.py runs/comfort/seed-2/policy.pt \
-        --seeds 1000-1004 --traffic 0.5,1.0 [--below 1]
+        --seeds 1000-1004 --traffic 0.5,1.0 [--below 1] [--scenarios random:104,105]
 
 Every episode runs once on the bare network's greedy choice and once on the same choice
 except on a free road (:func:`~explaindrive.env.ride_quality.free_road`, as the ride figures
@@ -11,7 +11,8 @@ allows it. Both runs collect the reward of the network's own recipe (its card) u
 own command; the script prints both returns and the terms that differ by more than 0.5.
 
 A higher return for the forced cruise on most episodes says the network's values, not its
-reward, keep it slow: its value of the faster speed is too low.
+reward, keep it slow: its value of the faster speed is too low. ``--scenarios`` drives
+generated scenarios held out from training instead of the paper's road.
 
 With ``--approach`` the second run forces a later braking instead: approaching a red or
 yellow light that is its leader (no vehicle closer), where the network would slow down, the
@@ -24,6 +25,7 @@ return then says the values, not the reward, make it brake early.
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 from pathlib import Path
 from typing import Any
@@ -31,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from explaindrive.agent.controller import QPolicy
+from explaindrive.cache import cache_dir
 from explaindrive.env import state as S
 from explaindrive.env.actions import IDLE_ACTION, action_index, speed_change
 from explaindrive.env.config import EnvConfig
@@ -39,6 +42,7 @@ from explaindrive.env.ride_quality import is_free_road
 from explaindrive.env.safety import VIRTUAL_TOL_M, safe_action_mask
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.parsing import parse_levels, parse_seeds
+from explaindrive.evaluation.scenarios import ScenarioCase, parse_scenarios
 
 ACCELERATE = action_index(1)
 
@@ -62,15 +66,19 @@ def episode(
     traffic: float,
     below: float | None,
     approach: float | None = None,
+    where: ScenarioCase | None = None,
 ) -> tuple[float, int, int, dict[str, float]]:
-    """One episode: its return, steps, forced steps and the sum of each reward term."""
+    """One episode (on the paper's road, or ``where``): its return, steps, forced steps and
+    the sum of each reward term."""
     mode = str(policy.card["mode"])
     config = policy.card.get("config", {})
     env = UrbanDriveEnv(
         config=EnvConfig(
+            **dict(where.fields if where else ()),
             traffic_level=traffic,
             yellow_leader=policy.yellow_leader,
             reward=config.get("reward", "paper"),
+            stop_window_m=config.get("stop_window_m"),
         )
     )
     try:
@@ -120,21 +128,24 @@ def main() -> None:
         default=None,
         help="[m/s^2] force a later braking for lights at this deceleration instead",
     )
+    parser.add_argument("--scenarios", help="generated scenarios, e.g. random:104,105")
     args = parser.parse_args()
+    wheres = parse_scenarios(args.scenarios, cache_dir()) if args.scenarios else (None,)
     policy = QPolicy.load(args.policy)
     below, approach = (None, args.approach) if args.approach is not None else (args.below, None)
     levels = parse_levels(args.traffic)
-    print("| seed | traffic | return as is | return forced | forced steps | terms forced - as is |")
-    print("|---|---|---|---|---|---|")
+    print("| road | seed | traffic | return as is | return forced | forced steps "
+          "| terms forced - as is |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
     better = runs = 0
-    for seed in parse_seeds(args.seeds):
-        for traffic in levels:
-            as_is = episode(policy, seed, traffic, None)
-            forced = episode(policy, seed, traffic, below, approach)
-            better, runs = better + int(forced[0] > as_is[0]), runs + 1
-            print(f"| {seed} | {traffic} | {as_is[0]:.1f} ({as_is[1]} steps) | "
-                  f"{forced[0]:.1f} ({forced[1]} steps) | {forced[2]} | "
-                  f"{_differences(forced[3], as_is[3])} |")  # fmt: skip
+    for where, seed, traffic in itertools.product(wheres, parse_seeds(args.seeds), levels):
+        road = where.name if where else "paper"
+        as_is = episode(policy, seed, traffic, None, where=where)
+        forced = episode(policy, seed, traffic, below, approach, where)
+        better, runs = better + int(forced[0] > as_is[0]), runs + 1
+        print(f"| {road} | {seed} | {traffic} | {as_is[0]:.1f} ({as_is[1]} steps) | "
+              f"{forced[0]:.1f} ({forced[1]} steps) | {forced[2]} | "
+              f"{_differences(forced[3], as_is[3])} |")  # fmt: skip
     what = "later braking" if approach is not None else "cruise"
     print(f"\nthe forced {what} returns more in {better} of {runs} episodes")
 
