@@ -42,7 +42,7 @@ from explaindrive.env.ride_quality import is_free_road
 from explaindrive.env.safety import VIRTUAL_TOL_M, safe_action_mask
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.parsing import parse_levels, parse_seeds
-from explaindrive.evaluation.scenarios import ScenarioCase, parse_scenarios
+from explaindrive.evaluation.scenarios import PAPER_ROAD, ScenarioCase, parse_scenarios
 
 ACCELERATE = action_index(1)
 
@@ -66,15 +66,15 @@ def episode(
     traffic: float,
     below: float | None,
     approach: float | None = None,
-    where: ScenarioCase | None = None,
+    where: ScenarioCase = PAPER_ROAD,
 ) -> tuple[float, int, int, dict[str, float]]:
-    """One episode (on the paper's road, or ``where``): its return, steps, forced steps and
-    the sum of each reward term."""
+    """One episode on ``where``: its return, steps, forced steps and the sum of each reward
+    term."""
     mode = str(policy.card["mode"])
     config = policy.card.get("config", {})
     env = UrbanDriveEnv(
         config=EnvConfig(
-            **dict(where.fields if where else ()),
+            **dict(where.fields),
             traffic_level=traffic,
             yellow_leader=policy.yellow_leader,
             reward=config.get("reward", "paper"),
@@ -130,7 +130,7 @@ def main() -> None:
     )
     parser.add_argument("--scenarios", help="generated scenarios, e.g. random:104,105")
     args = parser.parse_args()
-    wheres = parse_scenarios(args.scenarios, cache_dir()) if args.scenarios else (None,)
+    wheres = parse_scenarios(args.scenarios, cache_dir()) if args.scenarios else (PAPER_ROAD,)
     policy = QPolicy.load(args.policy)
     below, approach = (None, args.approach) if args.approach is not None else (args.below, None)
     levels = parse_levels(args.traffic)
@@ -139,11 +139,10 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|")
     better = runs = 0
     for where, seed, traffic in itertools.product(wheres, parse_seeds(args.seeds), levels):
-        road = where.name if where else "paper"
         as_is = episode(policy, seed, traffic, None, where=where)
         forced = episode(policy, seed, traffic, below, approach, where)
         better, runs = better + int(forced[0] > as_is[0]), runs + 1
-        print(f"| {road} | {seed} | {traffic} | {as_is[0]:.1f} ({as_is[1]} steps) | "
+        print(f"| {where.name} | {seed} | {traffic} | {as_is[0]:.1f} ({as_is[1]} steps) | "
               f"{forced[0]:.1f} ({forced[1]} steps) | {forced[2]} | "
               f"{_differences(forced[3], as_is[3])} |")  # fmt: skip
     what = "later braking" if approach is not None else "cruise"

@@ -6,8 +6,8 @@
 # SCENARIOS defaults to random:100-119, SEEDS to 0-4 and DRIVERS to "fast comfort krauss";
 # traffic levels 0.5, 1.0 and 1.75, with and without stops at 60-75 and 150-165 s.
 # The reference is the paper's road (road_*, with and without the stops) at the same levels
-# on ROAD_SEEDS, as many
-# episodes as the family by default (20 scenarios x 5 seeds); the grid runs on GRID_SEEDS.
+# on ROAD_SEEDS, as many episodes as the family by default (20 scenarios x 5 seeds); the
+# grid runs on GRID_SEEDS.
 # python scripts/family_ratios.py [out/family] prints every figure beside the reference.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -12,6 +12,7 @@ episodes.
 
 from __future__ import annotations
 
+import functools
 import json
 import sys
 from pathlib import Path
@@ -32,8 +33,10 @@ COUNTS = ("collision_episodes", "red_light_runs", "ped_violations", "speeding_st
 VARIANTS = ("family_{p}", "family_{p}_stops", "grid_{p}", "grid_{p}_stops")
 
 
+@functools.cache
 def overall(folder: Path, name: str) -> dict[str, Any] | None:
-    """The overall aggregates of run ``name``, or ``None`` if it was not run."""
+    """The overall aggregates of run ``name``, or ``None`` if it was not run (each file
+    read once: the tables compare every run with its reference)."""
     path = folder / f"{name}.json"
     if not path.is_file():
         return None

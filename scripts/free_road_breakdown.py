@@ -29,20 +29,19 @@ from explaindrive.env.ride_quality import SLOW_SHARE, is_free_road
 from explaindrive.env.state import SENSOR_RANGE_M
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.parsing import parse_levels, parse_seeds
-from explaindrive.evaluation.scenarios import ScenarioCase, parse_scenarios
+from explaindrive.evaluation.scenarios import PAPER_ROAD, ScenarioCase, parse_scenarios
 
 CHANGE_MPS = 0.5  # a speed change beyond this is accelerating or slowing down
 
 
 def free_road_steps(
-    policy: QPolicy, driver: str, seed: int, traffic: float, where: ScenarioCase | None = None
+    policy: QPolicy, driver: str, seed: int, traffic: float, where: ScenarioCase = PAPER_ROAD
 ) -> list[dict]:
-    """The free-road steps of one episode driven by the bare network or by SUMO's ``krauss``:
-    speed, previous speed, posted limit, light in range and leader in range. ``where``: a
-    scenario of the family (the paper's road if ``None``)."""
+    """The free-road steps of one episode driven by the bare network or by SUMO's ``krauss``
+    on ``where``: speed, previous speed, posted limit, light in range and leader in range."""
     mode = str(policy.card["mode"])
     config = EnvConfig(
-        **dict(where.fields if where else ()),
+        **dict(where.fields),
         traffic_level=traffic,
         ego_model="agent" if driver == "network" else driver,
         yellow_leader=policy.yellow_leader,
@@ -109,7 +108,7 @@ def main() -> None:
     parser.add_argument("--scenarios", help="generated scenarios, e.g. random:100-119")
     args = parser.parse_args()
     policy = QPolicy.load(args.policy)
-    wheres = parse_scenarios(args.scenarios, cache_dir()) if args.scenarios else (None,)
+    wheres = parse_scenarios(args.scenarios, cache_dir()) if args.scenarios else (PAPER_ROAD,)
     steps = {
         driver: [
             s

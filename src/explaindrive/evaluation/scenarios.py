@@ -28,6 +28,10 @@ class ScenarioCase:
     fields: tuple[tuple[str, Any], ...]
 
 
+PAPER_ROAD = ScenarioCase("paper", ())
+"""The paper's road: no fields choose another scenario."""
+
+
 def parse_scenarios(text: str, cache_dir: Path) -> tuple[ScenarioCase, ...]:
     """``random:SEEDS`` (e.g. ``random:100-119``) as built, held-out generated scenarios.
 
