@@ -185,3 +185,13 @@ def test_best_actions_by_hand() -> None:
     mask = np.ones((2, 7), bool)
     mask[0, 6] = mask[1, 0] = False
     assert D3QNLearner.best_actions(q, mask).tolist() == [1, 1]
+
+
+def test_the_loss_weighs_its_terms_by_hand() -> None:
+    # td 1, unsafe 2, boundary 3 with weights 0.5 and 0.25: 1 + 0.5 * 2 + 0.25 * 3 = 2.75;
+    # a term not computed (None) is left out, not counted as 0 times its weight.
+    learner = D3QNLearner(PAPER.replace(unsafe_loss_weight=0.5, boundary_weight=0.25))
+    td, unsafe, on_boundary = torch.tensor(1.0), torch.tensor(2.0), torch.tensor(3.0)
+    assert float(learner._total_loss(td, unsafe, on_boundary)) == 2.75
+    assert float(learner._total_loss(td, unsafe, None)) == 2.0
+    assert learner._total_loss(td, None, None) is td

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import torch
@@ -38,6 +38,19 @@ class UpdateStats:
     """The unsafe-action loss on synthetic boundary observations (0 without them)."""
     abs_td_errors: np.ndarray | None = None
     """|target - Q| of each row (prioritised replay's new priorities); ``None`` without it."""
+
+
+class _OnlineQ(NamedTuple):
+    """The online network's Q-values in one update (one forward pass)."""
+
+    states: torch.Tensor
+    """Of the batch's states, ``(B, n_actions)``."""
+    taken: torch.Tensor
+    """Of the taken actions, ``(B,)``."""
+    next_states: torch.Tensor
+    """Of the next states, ``(B, n_actions)``, detached: they choose, they do not learn."""
+    boundary: torch.Tensor
+    """Of the synthetic boundary rows, ``(M, n_actions)``; ``(0, n_actions)`` without them."""
 
 
 class D3QNLearner:
@@ -140,66 +153,173 @@ class D3QNLearner:
         ``boundary`` (synthetic observations and their masks,
         :mod:`explaindrive.agent.boundary`) the unsafe actions of those are pushed down
         too, weighted by ``boundary_weight``.
+
+        Args:
+            batch: the minibatch (with ``weights``, prioritised replay's).
+            env_steps: transitions collected so far (sets the learning rate).
+            boundary: synthetic observations and their safe-action masks, or ``None``.
+
+        Returns:
+            What the step did (losses, mean Q, learning rate, gradient norm, priorities).
         """
         c = self.config
-        lr = self.learning_rate(env_steps)
-        for group in self.optimizer.param_groups:
-            group["lr"] = lr
-        obs = torch.from_numpy(batch.obs)
-        next_obs = torch.from_numpy(batch.next_obs)
-        actions = torch.from_numpy(batch.actions).long()
-        rewards = torch.from_numpy(batch.rewards)
-        terminated = torch.from_numpy(batch.terminated)
-
-        extra = [torch.from_numpy(boundary[0])] if boundary is not None else []
-        q_all = self.q(torch.cat([obs, next_obs, *extra]))  # one forward pass for all
-        n = len(obs)
-        q_obs, next_online = q_all[:n], q_all[n : 2 * n].detach()
-        with torch.no_grad():
-            next_target = self.q_target(next_obs)
-        discount = torch.from_numpy(batch.discount)
-        next_mask = torch.from_numpy(batch.next_mask) if c.safe_learning else None
-        target = double_dqn_target(
-            rewards, terminated, next_online, next_target, discount, next_mask
-        )
-        q_taken = q_obs.gather(1, actions.unsqueeze(1)).squeeze(1)
+        lr = self._anneal_learning_rate(env_steps)
+        q = self._online_q(batch, boundary)
+        target = self._td_target(batch, q.next_states)
         weights = None if batch.weights is None else torch.from_numpy(batch.weights)
-        loss = td = td_loss(q_taken, target, c.loss, c.huber_delta, weights)
-        unsafe = on_boundary = torch.zeros(())
-        if c.safe_learning:
-            mask = torch.from_numpy(batch.mask)
-            unsafe = unsafe_action_loss(
-                q_obs, mask, c.unsafe_q, c.loss, c.huber_delta, self._margins(batch.obs)
-            )
-            loss = td + c.unsafe_loss_weight * unsafe
-            if boundary is not None:
-                margin = (
-                    self._margins(boundary[0]) if c.boundary_margin is None else c.boundary_margin
-                )
-                on_boundary = unsafe_action_loss(
-                    q_all[2 * n :], torch.from_numpy(boundary[1]), c.unsafe_q, c.loss,
-                    c.huber_delta, margin,
-                )  # fmt: skip
-                loss = loss + c.boundary_weight * on_boundary
-
-        self.optimizer.zero_grad(set_to_none=True)
-        loss.backward()
-        grad_norm = 0.0
-        if c.grad_clip_norm is not None:
-            grad_norm = float(torch.nn.utils.clip_grad_norm_(self.q.parameters(), c.grad_clip_norm))
-        self.optimizer.step()
+        td = td_loss(q.taken, target, c.loss, c.huber_delta, weights)
+        unsafe, on_boundary = self._unsafe_losses(batch, q, boundary)
+        grad_norm = self._optimise(self._total_loss(td, unsafe, on_boundary))
         self.updates += 1
         if self.updates % c.target_update_interval == 0:
             self.update_target(c.tau)
         return UpdateStats(
             td_loss=float(td.detach()),
-            unsafe_loss=float(unsafe.detach()),
-            boundary_loss=float(on_boundary.detach()),
-            q_values=float(q_taken.detach().mean()),
+            unsafe_loss=0.0 if unsafe is None else float(unsafe.detach()),
+            boundary_loss=0.0 if on_boundary is None else float(on_boundary.detach()),
+            q_values=float(q.taken.detach().mean()),
             learning_rate=lr,
             grad_norm=grad_norm,
-            abs_td_errors=(None if weights is None else (target - q_taken.detach()).abs().numpy()),
+            abs_td_errors=(None if weights is None else (target - q.taken.detach()).abs().numpy()),
         )
+
+    def _anneal_learning_rate(self, env_steps: int) -> float:
+        """Set the optimiser's learning rate to :meth:`learning_rate` of ``env_steps``.
+
+        Args:
+            env_steps: transitions collected so far.
+
+        Returns:
+            The learning rate set.
+        """
+        lr = self.learning_rate(env_steps)
+        for group in self.optimizer.param_groups:
+            group["lr"] = lr
+        return lr
+
+    def _online_q(
+        self, batch: ReplayBatch, boundary: tuple[np.ndarray, np.ndarray] | None
+    ) -> _OnlineQ:
+        """Online Q-values of the states, next states and boundary rows, in one forward pass.
+
+        Args:
+            batch: the minibatch.
+            boundary: synthetic observations and their masks, or ``None``.
+
+        Returns:
+            The Q-values, split by what they are of.
+        """
+        obs = torch.from_numpy(batch.obs)
+        next_obs = torch.from_numpy(batch.next_obs)
+        extra = [torch.from_numpy(boundary[0])] if boundary is not None else []
+        q_all = self.q(torch.cat([obs, next_obs, *extra]))  # one forward pass for all
+        n = len(obs)
+        q_obs = q_all[:n]
+        actions = torch.from_numpy(batch.actions).long()
+        return _OnlineQ(
+            states=q_obs,
+            taken=q_obs.gather(1, actions.unsqueeze(1)).squeeze(1),
+            next_states=q_all[n : 2 * n].detach(),
+            boundary=q_all[2 * n :],
+        )
+
+    def _td_target(self, batch: ReplayBatch, next_q_online: torch.Tensor) -> torch.Tensor:
+        """Double-DQN targets: the online net picks the next action, the target net values it.
+
+        With ``safe_learning`` the online net picks among the safe actions of the next state.
+
+        Args:
+            batch: the minibatch.
+            next_q_online: the online Q-values of its next states, detached.
+
+        Returns:
+            Targets of shape ``(B,)``, without gradient.
+        """
+        with torch.no_grad():
+            next_q_target = self.q_target(torch.from_numpy(batch.next_obs))
+        next_mask = torch.from_numpy(batch.next_mask) if self.config.safe_learning else None
+        return double_dqn_target(
+            torch.from_numpy(batch.rewards), torch.from_numpy(batch.terminated), next_q_online,
+            next_q_target, torch.from_numpy(batch.discount), next_mask,
+        )  # fmt: skip
+
+    def _unsafe_losses(
+        self,
+        batch: ReplayBatch,
+        q: _OnlineQ,
+        boundary: tuple[np.ndarray, np.ndarray] | None,
+    ) -> tuple[torch.Tensor | None, torch.Tensor | None]:
+        """The unsafe-action losses of ``safe_learning``, on the batch and on the boundary rows.
+
+        The batch's states use their stored masks and :meth:`_margins`; the boundary rows
+        their own masks and ``boundary_margin`` (:meth:`_margins` if unset).
+
+        Args:
+            batch: the minibatch.
+            q: the online Q-values of :meth:`_online_q`.
+            boundary: synthetic observations and their masks, or ``None``.
+
+        Returns:
+            (loss on the batch, loss on the boundary rows); ``None`` for a loss not computed:
+            both without ``safe_learning``, the second without ``boundary``.
+        """
+        c = self.config
+        if not c.safe_learning:
+            return None, None
+        unsafe = unsafe_action_loss(
+            q.states, torch.from_numpy(batch.mask), c.unsafe_q, c.loss, c.huber_delta,
+            self._margins(batch.obs),
+        )  # fmt: skip
+        if boundary is None:
+            return unsafe, None
+        margin = self._margins(boundary[0]) if c.boundary_margin is None else c.boundary_margin
+        on_boundary = unsafe_action_loss(
+            q.boundary, torch.from_numpy(boundary[1]), c.unsafe_q, c.loss, c.huber_delta, margin
+        )
+        return unsafe, on_boundary
+
+    def _total_loss(
+        self, td: torch.Tensor, unsafe: torch.Tensor | None, on_boundary: torch.Tensor | None
+    ) -> torch.Tensor:
+        """The loss to minimise: the TD loss plus the weighted unsafe-action losses.
+
+        ``td + unsafe_loss_weight * unsafe + boundary_weight * on_boundary``, leaving out the
+        terms not computed (``None``).
+
+        Args:
+            td: the TD loss.
+            unsafe: the unsafe-action loss on the batch's states.
+            on_boundary: the unsafe-action loss on the boundary rows.
+
+        Returns:
+            The loss the optimiser minimises.
+        """
+        c = self.config
+        loss = td
+        if unsafe is not None:
+            loss = loss + c.unsafe_loss_weight * unsafe
+        if on_boundary is not None:
+            loss = loss + c.boundary_weight * on_boundary
+        return loss
+
+    def _optimise(self, loss: torch.Tensor) -> float:
+        """One optimiser step on ``loss``, the gradients clipped to ``grad_clip_norm`` if set.
+
+        Args:
+            loss: the loss to minimise.
+
+        Returns:
+            The gradient norm before clipping; 0 when clipping is off.
+        """
+        self.optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        grad_norm = 0.0
+        if self.config.grad_clip_norm is not None:
+            grad_norm = float(
+                torch.nn.utils.clip_grad_norm_(self.q.parameters(), self.config.grad_clip_norm)
+            )
+        self.optimizer.step()
+        return grad_norm
 
     @torch.no_grad()
     def update_target(self, tau: float) -> None:
