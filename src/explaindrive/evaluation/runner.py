@@ -15,7 +15,7 @@ import multiprocessing
 import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -27,6 +27,7 @@ from explaindrive.evaluation.spec import EpisodeSpec, PolicySpec
 from explaindrive.processes import children_ignore_sigint
 
 if TYPE_CHECKING:
+    from explaindrive.env.config import EnvConfig
     from explaindrive.env.urban_drive import UrbanDriveEnv
 
 log = logging.getLogger(__name__)
@@ -82,21 +83,77 @@ def run_episode(
     ``after_reset(env)`` runs once the ego has entered, before the first step (for example
     to change the ego's SUMO parameters).
 
+    Args:
+        spec: the episode to run.
+        after_reset: called with the env once, after the reset.
+
+    Returns:
+        The episode's spec, figures, per-step trace and shield overrides.
+
     Raises:
         CheckpointError: if a policy file cannot be loaded.
         RuntimeError: if the ego cannot enter the road.
     """
-    from explaindrive.env.config import EnvConfig
     from explaindrive.env.urban_drive import UrbanDriveEnv
 
     policy = spec.policy
-    driver = None if policy.kind == "baseline" else _load_driver(policy)
-    overrides_before = 0
-    if driver is not None:
-        overrides_before = driver.overrides
-        driver.active_agent = (
-            Command.FAST if policy.kind == "merged" else Command.parse(policy.primary)
-        )
+    driver = _start_driver(policy)
+    overrides_before = driver.overrides if driver is not None else 0
+    config = _env_config(spec, driver)
+    env = UrbanDriveEnv(config=config)
+    try:
+        obs = _reset(env, spec)
+        if driver is not None:
+            driver.begin(config.obs_noise[1])
+        if after_reset is not None:
+            after_reset(env)
+        trace = _drive(policy, driver, env, obs)
+    finally:
+        env.close()
+    log.debug("episode %s seed=%d level=%g: %d steps", policy.name, spec.seed,
+              spec.traffic_level, len(trace.speeds_mps))  # fmt: skip
+    overrides = (driver.overrides - overrides_before) if driver is not None else 0
+    return EpisodeRecord(
+        spec, trace.metrics.result(), tuple(trace.speeds_mps), tuple(trace.commands), overrides
+    )
+
+
+def _start_driver(policy: PolicySpec) -> Any:
+    """The policy's (cached) controller, set to drive under its first command.
+
+    Args:
+        policy: the policy of the episode.
+
+    Returns:
+        The :class:`~explaindrive.agent.controller.MergedController`; ``None`` for a
+        baseline (SUMO drives the ego).
+
+    Raises:
+        CheckpointError: if a policy file cannot be loaded.
+    """
+    if policy.kind == "baseline":
+        return None
+    driver = _load_driver(policy)
+    driver.active_agent = Command.FAST if policy.kind == "merged" else Command.parse(policy.primary)
+    return driver
+
+
+def _env_config(spec: EpisodeSpec, driver: Any) -> EnvConfig:
+    """The env's config for an episode.
+
+    Baselines see no observation noise; a network drives in the environment it was trained
+    in (its yellow-light rule).
+
+    Args:
+        spec: the episode.
+        driver: its controller from :func:`_start_driver` (``None`` for a baseline).
+
+    Returns:
+        The config to build the env with.
+    """
+    from explaindrive.env.config import EnvConfig
+
+    policy = spec.policy
     config = EnvConfig(
         traffic_level=spec.traffic_level,
         max_steps=spec.max_steps,
@@ -104,39 +161,68 @@ def run_episode(
         obs_noise=spec.obs_noise if policy.kind != "baseline" else (0.0, 0.0),
         **dict(spec.scenario),
     )
-    if driver is not None:  # a network drives in the environment it was trained in
+    if driver is not None:
         config = config.replace(yellow_leader=driver.yellow_leader)
-    env = UrbanDriveEnv(config=config)
-    metrics = EpisodeMetrics()
-    speeds: list[float] = []
-    commands: list[str] = []
-    try:
-        obs, _info = env.reset(
-            seed=spec.seed,
-            options={
-                "command": spec.command,
-                "traffic_level": spec.traffic_level,
-                "command_schedule": [list(item) for item in spec.schedule],
-            },
-        )
-        if driver is not None:
-            driver.begin(config.obs_noise[1])
-        if after_reset is not None:
-            after_reset(env)
-        done = False
-        while not done:
-            action = _decide(policy, driver, env, obs)
-            obs, reward, terminated, truncated, info = env.step(action)
-            metrics.update(info, reward)
-            speeds.append(float(info["speed_mps"]))
-            commands.append(str(info["command"]))
-            done = terminated or truncated
-    finally:
-        env.close()
-    log.debug("episode %s seed=%d level=%g: %d steps", policy.name, spec.seed,
-              spec.traffic_level, len(speeds))  # fmt: skip
-    overrides = (driver.overrides - overrides_before) if driver is not None else 0
-    return EpisodeRecord(spec, metrics.result(), tuple(speeds), tuple(commands), overrides)
+    return config
+
+
+def _reset(env: UrbanDriveEnv, spec: EpisodeSpec) -> np.ndarray:
+    """Reset ``env`` to the episode's seed, traffic level, command and command schedule.
+
+    Args:
+        env: the episode's env.
+        spec: the episode.
+
+    Returns:
+        The first observation.
+
+    Raises:
+        RuntimeError: if the ego cannot enter the road.
+    """
+    obs, _info = env.reset(
+        seed=spec.seed,
+        options={
+            "command": spec.command,
+            "traffic_level": spec.traffic_level,
+            "command_schedule": [list(item) for item in spec.schedule],
+        },
+    )
+    return obs
+
+
+@dataclass(slots=True)
+class _Trace:
+    """What the steps of one episode recorded."""
+
+    metrics: EpisodeMetrics = field(default_factory=EpisodeMetrics)
+    speeds_mps: list[float] = field(default_factory=list)
+    """Ego speed after each step [m/s]."""
+    commands: list[str] = field(default_factory=list)
+    """The command under which each step's action was taken."""
+
+
+def _drive(policy: PolicySpec, driver: Any, env: UrbanDriveEnv, obs: np.ndarray) -> _Trace:
+    """Step ``env`` from ``obs`` until the episode terminates or is truncated.
+
+    Args:
+        policy: the policy of the episode.
+        driver: its controller (``None`` for a baseline).
+        env: the env, just reset.
+        obs: its first observation.
+
+    Returns:
+        The metrics, speeds and commands of every step.
+    """
+    trace = _Trace()
+    done = False
+    while not done:
+        action = _decide(policy, driver, env, obs)
+        obs, reward, terminated, truncated, info = env.step(action)
+        trace.metrics.update(info, reward)
+        trace.speeds_mps.append(float(info["speed_mps"]))
+        trace.commands.append(str(info["command"]))
+        done = terminated or truncated
+    return trace
 
 
 def _worker_init() -> None:
