@@ -24,14 +24,10 @@ from rich.console import Console
 from rich.table import Table
 
 from explaindrive.language.config import LanguageConfig
-from explaindrive.language.datasets import (
-    DECISIONS_JSONL,
-    TEST_CSV,
-    data_path,
-    load_commands,
-    load_decisions,
-)
-from explaindrive.language.encoders import DEFAULT_RUNTIME, RUNTIMES, encoder_threads
+from explaindrive.language.data import DECISIONS_JSONL, TEST_CSV, data_path
+from explaindrive.language.explanation.datasets import load_decisions
+from explaindrive.language.intent.datasets import load_commands
+from explaindrive.language.intent.encoders import DEFAULT_RUNTIME, RUNTIMES, encoder_threads
 from explaindrive.language.stack import make_language_stack
 
 SENTENCES = (

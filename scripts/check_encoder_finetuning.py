@@ -20,17 +20,12 @@ import numpy as np
 import torch
 from numpy.typing import NDArray
 
-from explaindrive.language.datasets import (
-    INTENT_LABELS,
-    TRAIN_CSV,
-    CommandExample,
-    data_path,
-    load_commands,
-)
-from explaindrive.language.encoders import minilm_model_dir
-from explaindrive.language.features import features_from_embeddings, normalize_text
-from explaindrive.language.intent_classifier import NONE, STOP, IntentClassifier, decide_rows
-from explaindrive.language.intent_training import Encoded, Hyper, Selection, fit_final
+from explaindrive.language.data import TRAIN_CSV, data_path
+from explaindrive.language.intent.classifier import NONE, STOP, IntentClassifier, decide_rows
+from explaindrive.language.intent.datasets import INTENT_LABELS, CommandExample, load_commands
+from explaindrive.language.intent.encoders import minilm_model_dir
+from explaindrive.language.intent.features import features_from_embeddings, normalize_text
+from explaindrive.language.intent.training import Encoded, Hyper, Selection, fit_final
 
 LOGIT_SCALE = 20.0  # cosine similarities times this are the head's logits
 BATCH = 32

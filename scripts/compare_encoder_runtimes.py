@@ -16,15 +16,14 @@ import argparse
 
 import numpy as np
 
-from explaindrive.language.datasets import (
-    TEST_CSV,
-    TRAIN_CSV,
-    TRAIN_SPLIT,
-    data_path,
-    load_commands,
+from explaindrive.language.data import TEST_CSV, TRAIN_CSV, data_path
+from explaindrive.language.intent.classifier import IntentClassifier, decide_rows
+from explaindrive.language.intent.datasets import TRAIN_SPLIT, load_commands
+from explaindrive.language.intent.features import (
+    SentenceEncoder,
+    features_from_embeddings,
+    normalize_text,
 )
-from explaindrive.language.features import SentenceEncoder, features_from_embeddings, normalize_text
-from explaindrive.language.intent_classifier import IntentClassifier, decide_rows
 
 
 def main() -> None:

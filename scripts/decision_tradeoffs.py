@@ -22,11 +22,12 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from explaindrive.language.datasets import TRAIN_CSV, data_path, load_commands, training_splits
-from explaindrive.language.encoders import RUNTIMES
-from explaindrive.language.features import SentenceEncoder
-from explaindrive.language.intent_classifier import NONE, STOP, IntentClassifier, decide_rows
-from explaindrive.language.intent_training import BUILD_RUNTIME, Encoded, Hyper, held_out_proba
+from explaindrive.language.data import TRAIN_CSV, data_path
+from explaindrive.language.intent.classifier import NONE, STOP, IntentClassifier, decide_rows
+from explaindrive.language.intent.datasets import load_commands, training_splits
+from explaindrive.language.intent.encoders import RUNTIMES
+from explaindrive.language.intent.features import SentenceEncoder
+from explaindrive.language.intent.training import BUILD_RUNTIME, Encoded, Hyper, held_out_proba
 
 
 def main() -> None:

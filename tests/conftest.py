@@ -22,8 +22,8 @@ from explaindrive.language.config import LanguageConfig
 MODEL_FIXTURES = frozenset({"interpreter", "transcriber", "speak"})
 MODEL_MODULES = frozenset({
     "tests/ride/test_ride_shipped.py", "tests/ride/test_stop_lane.py",
-    "tests/language/test_cli.py", "tests/language/test_shipped_models.py",
-    "tests/language/test_onnx_encoder.py", "tests/language/test_openai_backend.py",
+    "tests/language/test_cli.py", "tests/language/intent/test_shipped_models.py",
+    "tests/language/intent/test_onnx_encoder.py", "tests/language/backends/test_openai.py",
     "tests/web/test_uploads.py", "tests/ride/test_ride_model_choice.py",
 })  # fmt: skip
 

@@ -16,8 +16,8 @@ import pytest
 from explaindrive.language.backends.embedded import RuleDecider
 from explaindrive.language.backends.openai import ChatClient, OpenAIDecider
 from explaindrive.language.config import OpenAIConfig
-from explaindrive.language.intent import IntentResult
-from explaindrive.language.summary import StateRecord
+from explaindrive.language.explanation.summary import StateRecord
+from explaindrive.language.intent.interpreter import IntentResult
 from explaindrive.redact import MASK, RedactingFilter, redact, redact_json
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.runner import run_ride

@@ -52,7 +52,7 @@ _LAZY: dict[str, str] = {
     "LanguageStack": "explaindrive.language.stack",
     "make_language_stack": "explaindrive.language.stack",
     "LanguageConfig": "explaindrive.language.config",
-    "Transcriber": "explaindrive.language.speech",
+    "Transcriber": "explaindrive.language.speech.transcriber",
     "RideSession": "explaindrive.ride.session",
     "RideConfig": "explaindrive.ride.config",
 }

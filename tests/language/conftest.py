@@ -16,7 +16,7 @@ from typing import Any
 import pytest
 
 from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
-from explaindrive.language.speech import Transcriber
+from explaindrive.language.speech.transcriber import Transcriber
 
 
 @pytest.fixture(scope="session")

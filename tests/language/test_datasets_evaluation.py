@@ -9,20 +9,16 @@ import pytest
 
 from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
 from explaindrive.language.config import LanguageConfig
-from explaindrive.language.datasets import (
-    BLIND_CSV,
-    DECISIONS_JSONL,
+from explaindrive.language.data import BLIND_CSV, DECISIONS_JSONL, TEST_CSV, TRAIN_CSV, data_path
+from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
+from explaindrive.language.explanation.datasets import load_decisions
+from explaindrive.language.explanation.explainer import present_factors
+from explaindrive.language.intent.datasets import (
     RESERVE_SPLIT,
-    TEST_CSV,
-    TRAIN_CSV,
     CommandExample,
-    data_path,
     load_commands,
-    load_decisions,
     training_splits,
 )
-from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
-from explaindrive.language.explanation import present_factors
 
 NEAR_COPY = 0.8  # character similarity (difflib ratio) from which a text counts as a near-copy
 

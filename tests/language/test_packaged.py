@@ -67,7 +67,7 @@ def test_transcribe_refuses_tampered_weights_in_one_line(
     from explaindrive.cli.app import app
 
     (fake_package / "model.bin").write_bytes(b"tampered")
-    monkeypatch.setattr("explaindrive.language.speech.WHISPER_TINY_EN", TOY)
+    monkeypatch.setattr("explaindrive.language.speech.transcriber.WHISPER_TINY_EN", TOY)
     clip = tmp_path / "clip.wav"
     with wave.open(str(clip), "wb") as w:
         w.setnchannels(1)

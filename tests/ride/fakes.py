@@ -13,12 +13,21 @@ from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.env.scripted import CautiousDriver
 from explaindrive.env.state import CMD
 from explaindrive.env.urban_drive import UrbanDriveEnv
-from explaindrive.language.decision import Conflict, Decision, ExplanationDecider, Factor
-from explaindrive.language.explanation import Explainer, Explanation
-from explaindrive.language.intent import IntentInterpreter, IntentResult, format_confirmation
-from explaindrive.language.speech import Transcript
+from explaindrive.language.explanation.decision import (
+    Conflict,
+    Decision,
+    ExplanationDecider,
+    Factor,
+)
+from explaindrive.language.explanation.explainer import Explainer, Explanation
+from explaindrive.language.explanation.summary import StateRecord
+from explaindrive.language.intent.interpreter import (
+    IntentInterpreter,
+    IntentResult,
+    format_confirmation,
+)
+from explaindrive.language.speech.transcriber import Transcript
 from explaindrive.language.stack import LanguageStack
-from explaindrive.language.summary import StateRecord
 
 
 class ScriptedController:

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from explaindrive.language.speech import Transcript
+from explaindrive.language.speech.transcriber import Transcript
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.web import create_app

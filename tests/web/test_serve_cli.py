@@ -66,8 +66,8 @@ def test_a_trained_network_reaches_the_rides(
 def test_the_configured_model_reaches_the_endpoint(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
+    from explaindrive.language.explanation.summary import StateRecord
     from explaindrive.language.stack import make_language_stack
-    from explaindrive.language.summary import StateRecord
     from explaindrive.web import server as web_server
     from explaindrive.web.app import RealStack
     from tests.language.conftest import ScriptedOpenAI

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from fastapi.testclient import TestClient
 
-from explaindrive.language.speech import AudioError, Transcript
+from explaindrive.language.speech.transcriber import AudioError, Transcript
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.session import RideSession
 from explaindrive.web import create_app

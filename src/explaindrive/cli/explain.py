@@ -21,7 +21,7 @@ from explaindrive.cli._language_common import (
 )
 
 if TYPE_CHECKING:
-    from explaindrive.language.summary import StateRecord
+    from explaindrive.language.explanation.summary import StateRecord
 
 
 def explain_command(
@@ -32,7 +32,7 @@ def explain_command(
     model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Decide whether a step's action needs explaining and, if so, explain it."""
-    from explaindrive.language.summary import environment_summary
+    from explaindrive.language.explanation.summary import environment_summary
 
     try:
         record = read_case(case)
@@ -80,7 +80,7 @@ def read_case(path: Path) -> StateRecord:
     except UnicodeDecodeError as exc:
         raise ValueError(f"{path}: not UTF-8 text (byte {exc.start}: {exc.reason})") from exc
     _check_finite(text, str(path))
-    from explaindrive.language.summary import StateRecord
+    from explaindrive.language.explanation.summary import StateRecord
 
     return StateRecord.from_json(text, source=str(path))
 

@@ -27,7 +27,7 @@ def interpret_command(
     model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
 ) -> None:
     """Map a passenger request (text or --audio) to fast, comfort, stop or no command."""
-    from explaindrive.language.speech import AudioError
+    from explaindrive.language.speech.transcriber import AudioError
 
     if (text is None) == (audio is None):
         fail("give either TEXT or --audio FILE")

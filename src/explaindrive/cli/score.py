@@ -25,7 +25,7 @@ score_app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
 )
-# the shipped files (explaindrive.language.datasets), named without importing the readers
+# the shipped files (explaindrive.language.data), named without importing the readers
 SHIPPED_COMMANDS = "the shipped commands_test.csv"
 SHIPPED_DECISIONS = "the shipped decisions.jsonl"
 
@@ -59,7 +59,8 @@ def intents_command(
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1; with a
     remote model, also the figures each trust_embedded_from would give on its replies."""
-    from explaindrive.language.datasets import TEST_CSV, data_path, load_commands
+    from explaindrive.language.data import TEST_CSV, data_path
+    from explaindrive.language.intent.datasets import load_commands
 
     refuse_bad_outputs(files=((out, "--json"),))
     data = data or data_path(TEST_CSV)
@@ -129,7 +130,8 @@ def decisions_command(
 ) -> None:
     """Trigger accuracy/precision/recall/F1, factor accuracy and checked explanations of
     LLM-2/LLM-3."""
-    from explaindrive.language.datasets import DECISIONS_JSONL, data_path, load_decisions
+    from explaindrive.language.data import DECISIONS_JSONL, data_path
+    from explaindrive.language.explanation.datasets import load_decisions
 
     refuse_bad_outputs(files=((out, "--json"),))
     data = data or data_path(DECISIONS_JSONL)

@@ -48,7 +48,7 @@ def serve(
     from explaindrive.agent.checkpoint import CheckpointError
     from explaindrive.agent.controller import MergedController
     from explaindrive.language.backends import check_backend
-    from explaindrive.language.encoders import check_installed
+    from explaindrive.language.intent.encoders import check_installed
     from explaindrive.web import create_app
     from explaindrive.web.app import RealStack
     from explaindrive.web.guard import LOOPBACK_HOSTS, served_hosts

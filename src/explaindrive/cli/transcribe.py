@@ -16,7 +16,7 @@ def transcribe_command(
     config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
 ) -> None:
     """Transcribe a spoken request with Whisper (tiny.en, offline)."""
-    from explaindrive.language.speech import AudioError, Transcriber
+    from explaindrive.language.speech.transcriber import AudioError, Transcriber
 
     cfg = load_config(config)
     try:

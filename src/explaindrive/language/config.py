@@ -10,7 +10,7 @@ from pydantic import AfterValidator, Field
 
 from explaindrive.config import LaxModel, read_yaml
 from explaindrive.language.backends.registry import check_backend
-from explaindrive.language.encoders import (
+from explaindrive.language.intent.encoders import (
     DEFAULT_RUNTIME,
     EncoderRuntime,
     check_runtime,
@@ -88,7 +88,7 @@ class OpenAIConfig(LaxModel):
     max_tokens: int = Field(default=120, ge=8)
     trust_embedded_from: float = Field(default=0.8, ge=0.0, le=1.0)
     """The embedded reading's probability from which a different reading of the model does
-    not replace it (:mod:`explaindrive.language.agreement`): 0 leaves every reading to the
+    not replace it (:mod:`explaindrive.language.intent.agreement`): 0 leaves every reading to the
     embedded interpreter, 1 lets the model change any reading it does not share but a STOP.
     Choose it per model with ``explaindrive score intents --backend openai --data`` on the
     ``reserve`` split (docs/language.md)."""

@@ -14,14 +14,15 @@ from sklearn.metrics import (
 )
 
 from explaindrive.commands import COMMAND_LABELS
-from explaindrive.language.agreement import TwoReadings, trust_sweep
-from explaindrive.language.datasets import CommandExample, LabelledRecord
-from explaindrive.language.decision import ExplanationDecider
-from explaindrive.language.explanation import Explainer, check_grounding, present_factors
-from explaindrive.language.grounding import reply_problems
-from explaindrive.language.hazards import Factor
-from explaindrive.language.intent import IntentInterpreter, is_template_compliant
-from explaindrive.language.summary import StateRecord
+from explaindrive.language.explanation.datasets import LabelledRecord
+from explaindrive.language.explanation.decision import ExplanationDecider
+from explaindrive.language.explanation.explainer import Explainer, check_grounding, present_factors
+from explaindrive.language.explanation.grounding import reply_problems
+from explaindrive.language.explanation.hazards import Factor
+from explaindrive.language.explanation.summary import StateRecord
+from explaindrive.language.intent.agreement import TwoReadings, trust_sweep
+from explaindrive.language.intent.datasets import CommandExample
+from explaindrive.language.intent.interpreter import IntentInterpreter, is_template_compliant
 
 CONFUSION_LABELS: tuple[str, ...] = (*COMMAND_LABELS, "none")
 
@@ -94,8 +95,8 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
     embedded STOP lane, or an empty line). ``by_kind`` gives [correct, total] per kind;
     ``negated_stops_read_as_stop`` counts the rows of kind ``negated_stop`` read as STOP.
     With a remote model, ``trust_sweep`` gives the figures each ``trust_embedded_from`` of
-    :data:`~explaindrive.language.agreement.TRUST_GRID` would have given on the same
-    replies (:func:`~explaindrive.language.agreement.trust_sweep`).
+    :data:`~explaindrive.language.intent.agreement.TRUST_GRID` would have given on the same
+    replies (:func:`~explaindrive.language.intent.agreement.trust_sweep`).
     """
     preds: list[str] = []
     confs: list[str | None] = []
@@ -160,7 +161,7 @@ def evaluate_decisions(
     explain; ``factor_accuracy_multi`` over those whose state holds two or more objects
     (light, crossing, leader) within the cut-off. Every explanation is checked: it names
     the labelled factor and no factor absent from the state (``grounded_share``), and it
-    passes :func:`~explaindrive.language.grounding.reply_problems` — the light's colour,
+    passes :func:`~explaindrive.language.explanation.grounding.reply_problems` — the light's colour,
     distances and speeds, and wording true of the action and speed (``truthful_share``).
     """
     truth: list[bool] = []

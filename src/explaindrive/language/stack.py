@@ -7,10 +7,10 @@ from dataclasses import dataclass
 
 from explaindrive.language.backends import check_backend, get_backend
 from explaindrive.language.config import LanguageConfig
-from explaindrive.language.decision import ExplanationDecider
-from explaindrive.language.explanation import Explainer
-from explaindrive.language.intent import IntentInterpreter
-from explaindrive.language.speech import SpeechToText, Transcriber
+from explaindrive.language.explanation.decision import ExplanationDecider
+from explaindrive.language.explanation.explainer import Explainer
+from explaindrive.language.intent.interpreter import IntentInterpreter
+from explaindrive.language.speech.transcriber import SpeechToText, Transcriber
 
 
 @dataclass(frozen=True)

@@ -11,9 +11,9 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
-from explaindrive.language.decision import Decision
-from explaindrive.language.explanation import Explanation
-from explaindrive.language.summary import StateRecord
+from explaindrive.language.explanation.decision import Decision
+from explaindrive.language.explanation.explainer import Explanation
+from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.jobs import DecideJob, ExplainJob
 from explaindrive.ride.lane import EXPLANATION, LanguageLane, Outcome, TaskKind

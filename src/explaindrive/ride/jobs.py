@@ -9,8 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
-from explaindrive.language.intent import IntentResult
-from explaindrive.language.summary import StateRecord
+from explaindrive.language.explanation.summary import StateRecord
+from explaindrive.language.intent.interpreter import IntentResult
 from explaindrive.ride.records import PassengerRequest
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from explaindrive.commands import Command
-from explaindrive.language.speech import AudioError
+from explaindrive.language.speech.transcriber import AudioError
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
 from explaindrive.ride.jobs import Interpretation, InterpretJob

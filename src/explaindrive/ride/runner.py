@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from explaindrive.jsonsafe import finite
-from explaindrive.language.intent import parse_confirmation_answer
+from explaindrive.language.intent.interpreter import parse_confirmation_answer
 from explaindrive.redact import redact, redact_json
 from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
 from explaindrive.ride.plot import plot_ride

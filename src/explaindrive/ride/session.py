@@ -26,7 +26,7 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import speed_change
 from explaindrive.env.metrics import EpisodeMetrics
 from explaindrive.env.urban_drive import UrbanDriveEnv
-from explaindrive.language.summary import StateRecord
+from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
 from explaindrive.ride.explaining import Explanations

@@ -15,7 +15,7 @@ import threading
 import time
 from pathlib import Path
 
-from explaindrive.language.speech import SpeechToText, Transcript
+from explaindrive.language.speech.transcriber import SpeechToText, Transcript
 from explaindrive.ride.session import RideSession
 
 log = logging.getLogger(__name__)

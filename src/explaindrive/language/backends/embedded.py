@@ -7,25 +7,30 @@ import time
 
 from explaindrive.commands import Command
 from explaindrive.language.config import EmbeddedConfig
-from explaindrive.language.corrections import last_instruction
-from explaindrive.language.datasets import INTENT_LABELS
-from explaindrive.language.decision import Decision, ExplanationDecider, Factor, rule_decision
-from explaindrive.language.explanation import (
+from explaindrive.language.explanation.decision import (
+    Decision,
+    ExplanationDecider,
+    Factor,
+    rule_decision,
+)
+from explaindrive.language.explanation.explainer import (
     Explainer,
     Explanation,
     neutral_explanation,
     template_explanation,
 )
-from explaindrive.language.features import SentenceEncoder, features
-from explaindrive.language.intent import (
+from explaindrive.language.explanation.summary import StateRecord
+from explaindrive.language.intent.classifier import IntentClassifier
+from explaindrive.language.intent.corrections import last_instruction
+from explaindrive.language.intent.datasets import INTENT_LABELS
+from explaindrive.language.intent.features import SentenceEncoder, features
+from explaindrive.language.intent.interpreter import (
     REPHRASE_MESSAGE,
     IntentInterpreter,
     IntentResult,
     format_confirmation,
 )
-from explaindrive.language.intent_classifier import IntentClassifier
-from explaindrive.language.negation import stop_is_ruled_out
-from explaindrive.language.summary import StateRecord
+from explaindrive.language.intent.negation import stop_is_ruled_out
 
 log = logging.getLogger(__name__)
 
@@ -58,10 +63,10 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         """Classify ``text``; an empty or off-topic request gets a request to rephrase.
 
         A request that corrects itself is read by its last instruction: the part after
-        its last repair marker (:func:`~explaindrive.language.corrections.last_instruction`)
+        its last repair marker (:func:`~explaindrive.language.intent.corrections.last_instruction`)
         decides whenever it asks for a command on its own. A line that mentions stopping
         only negated or in a complaint
-        (:func:`~explaindrive.language.negation.stop_is_ruled_out`) is not read as STOP.
+        (:func:`~explaindrive.language.intent.negation.stop_is_ruled_out`) is not read as STOP.
         """
         t0 = time.perf_counter()
         if not text or not text.strip():
@@ -96,7 +101,8 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
 
 
 class RuleDecider(ExplanationDecider):
-    """LLM-2 offline: the grounded rule engine of :mod:`explaindrive.language.decision`."""
+    """LLM-2 offline: the grounded rule engine of
+    :mod:`explaindrive.language.explanation.decision`."""
 
     name = NAME
 

@@ -1,10 +1,10 @@
 """OpenAI-compatible backend (OpenAI, Ollama, vLLM, llama.cpp) with the paper's prompts.
 
-Every reply is read by :mod:`~explaindrive.language.replies` (tolerant of wrappers,
+Every reply is read by :mod:`~explaindrive.language.backends.replies` (tolerant of wrappers,
 strict in meaning) and held to the state: LLM-1's reading is weighed against the
-embedded one (:mod:`~explaindrive.language.agreement`), an LLM-2 ``[EXPLAIN]`` the state
+embedded one (:mod:`~explaindrive.language.intent.agreement`), an LLM-2 ``[EXPLAIN]`` the state
 does not bear out is vetoed, and LLM-3's text is checked against the state
-(:mod:`~explaindrive.language.grounding`). A reply that cannot be read or is untrue, an
+(:mod:`~explaindrive.language.explanation.grounding`). A reply that cannot be read or is untrue, an
 HTTP error or a call past its total deadline falls back to the embedded module and the
 result says so (``fallback=True``, ``error=...``). The raw reply is kept in
 ``raw_reply`` for the ride log; the passenger sees only the checked, cleaned result.
@@ -19,7 +19,6 @@ import time
 from typing import Any, TypeVar
 
 from explaindrive.commands import Command
-from explaindrive.language.agreement import reconcile
 from explaindrive.language.backends import deadline
 from explaindrive.language.backends.deadline import DeadlineExceededError
 from explaindrive.language.backends.embedded import (
@@ -27,8 +26,14 @@ from explaindrive.language.backends.embedded import (
     RuleDecider,
     TemplateExplainer,
 )
+from explaindrive.language.backends.replies import (
+    NOT_A_REQUEST,
+    passenger_text,
+    read_confirmation,
+    read_decision_tag,
+)
 from explaindrive.language.config import OpenAIConfig
-from explaindrive.language.decision import (
+from explaindrive.language.explanation.decision import (
     EXPLAIN_TAG,
     NO_EXPLANATION_TAG,
     Decision,
@@ -37,21 +42,20 @@ from explaindrive.language.decision import (
     most_critical_factor,
     rule_decision,
 )
-from explaindrive.language.explanation import Explainer, Explanation
-from explaindrive.language.grounding import reply_problems
-from explaindrive.language.intent import (
+from explaindrive.language.explanation.explainer import Explainer, Explanation
+from explaindrive.language.explanation.grounding import reply_problems
+from explaindrive.language.explanation.summary import (
+    StateRecord,
+    describe_action,
+    environment_summary,
+)
+from explaindrive.language.intent.agreement import reconcile
+from explaindrive.language.intent.interpreter import (
     REPHRASE_MESSAGE,
     IntentInterpreter,
     IntentResult,
     format_confirmation,
 )
-from explaindrive.language.replies import (
-    NOT_A_REQUEST,
-    passenger_text,
-    read_confirmation,
-    read_decision_tag,
-)
-from explaindrive.language.summary import StateRecord, describe_action, environment_summary
 from explaindrive.redact import redact
 
 log = logging.getLogger(__name__)
@@ -211,8 +215,8 @@ class OpenAIIntentInterpreter(IntentInterpreter):
         The embedded interpreter reads every request first (tens of milliseconds). A STOP
         found there is returned at once (``stop_lane=True``) without asking the endpoint,
         so a STOP never waits on a remote model. Otherwise the endpoint's reply is read
-        (:func:`~explaindrive.language.replies.read_confirmation`) and the two readings
-        are reconciled (:func:`~explaindrive.language.agreement.reconcile`). On any
+        (:func:`~explaindrive.language.backends.replies.read_confirmation`) and the two readings
+        are reconciled (:func:`~explaindrive.language.intent.agreement.reconcile`). On any
         failure, the deadline and an unreadable reply included, the embedded reading
         stands in (``fallback=True``). The confirmation is always the template of the
         command that counts, never the model's text.
@@ -330,8 +334,8 @@ class OpenAIExplainer(Explainer):
         """Ask for an explanation, clean it and check it against the state before use.
 
         The reply is reduced to plain text for the passenger
-        (:func:`~explaindrive.language.replies.passenger_text`) and must then pass
-        :func:`~explaindrive.language.grounding.reply_problems` (it names the factor, or
+        (:func:`~explaindrive.language.backends.replies.passenger_text`) and must then pass
+        :func:`~explaindrive.language.explanation.grounding.reply_problems` (it names the factor, or
         with none given a factor present in the state, and nothing absent; the light's
         true colour, distances and speeds near the state's, wording true of the action);
         otherwise the template explanation stands in and ``error`` says why. With no

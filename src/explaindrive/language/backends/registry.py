@@ -16,9 +16,9 @@ from typing import TYPE_CHECKING, ClassVar, TypeVar
 
 if TYPE_CHECKING:
     from explaindrive.language.config import LanguageConfig
-    from explaindrive.language.decision import ExplanationDecider
-    from explaindrive.language.explanation import Explainer
-    from explaindrive.language.intent import IntentInterpreter
+    from explaindrive.language.explanation.decision import ExplanationDecider
+    from explaindrive.language.explanation.explainer import Explainer
+    from explaindrive.language.intent.interpreter import IntentInterpreter
 
 
 class UnknownBackendError(ValueError):

@@ -1,0 +1,102 @@
+"""Readers for LLM-1's command files (with clear errors on bad files).
+
+A command file is a CSV with columns ``text,label[,kind][,split]``. ``label`` is fast,
+comfort, stop or none (off-topic); ``kind`` says what sort of request it is (direct,
+indirect, negation, noise, offtopic, correction, tampered). The shipped files are named in
+:mod:`explaindrive.language.data`.
+
+The ``split`` column of :data:`~explaindrive.language.data.TRAIN_CSV` says what building
+LLM-1 does with a request:
+
+* ``train``: always fitted on.
+* ``dev-1`` ... ``dev-N``: the development splits. For the choice of hyper-parameters, the
+  STOP threshold and the none margin, each is predicted by a model fitted on ``train`` and
+  the other development splits; the shipped model is then fitted on ``train`` and all of
+  them (:mod:`explaindrive.language.intent.training`).
+* ``reserve``: neither fitted on nor used for choices by the shipped model; free for checks
+  and for a later model's development.
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+INTENT_LABELS: tuple[str, ...] = ("fast", "comfort", "stop", "none")
+TRAIN_SPLIT = "train"
+DEV_PREFIX = "dev-"
+RESERVE_SPLIT = "reserve"
+_SPLIT = re.compile(rf"{TRAIN_SPLIT}|{RESERVE_SPLIT}|{DEV_PREFIX}[1-9][0-9]*")
+
+
+@dataclass(frozen=True, slots=True)
+class CommandExample:
+    """One labelled passenger request; ``label`` is ``none`` for off-topic requests and
+    ``split`` is empty in a file without that column."""
+
+    text: str
+    label: str
+    kind: str = ""
+    split: str = ""
+
+
+def load_commands(path: str | Path) -> list[CommandExample]:
+    """Read a command CSV.
+
+    Raises:
+        FileNotFoundError: if the file is missing.
+        ValueError: on missing columns, an empty text, an unknown label or split (with line
+            number).
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"command file not found: {p}")
+    with p.open(newline="", encoding="utf-8") as fh:
+        reader = csv.DictReader(fh)
+        if reader.fieldnames is None or not {"text", "label"} <= set(reader.fieldnames):
+            raise ValueError(f"{p}: expected a CSV header with columns text,label[,kind][,split]")
+        out: list[CommandExample] = []
+        for line, row in enumerate(reader, start=2):
+            text = (row.get("text") or "").strip()
+            label = (row.get("label") or "").strip().lower()
+            if not text:
+                raise ValueError(f"{p}:{line}: empty text")
+            if label not in INTENT_LABELS:
+                raise ValueError(
+                    f"{p}:{line}: unknown label {label!r}; expected one of {INTENT_LABELS}"
+                )
+            split = (row.get("split") or "").strip()
+            if "split" in reader.fieldnames and not _SPLIT.fullmatch(split):
+                raise ValueError(
+                    f"{p}:{line}: unknown split {split!r}; expected {TRAIN_SPLIT}, "
+                    f"{DEV_PREFIX}<k> or {RESERVE_SPLIT}"
+                )
+            out.append(CommandExample(text, label, (row.get("kind") or "").strip(), split))
+    if not out:
+        raise ValueError(f"{p}: no rows")
+    return out
+
+
+def training_splits(
+    rows: list[CommandExample],
+) -> tuple[list[CommandExample], list[list[CommandExample]]]:
+    """The ``train`` requests and the development splits ``dev-1`` ... ``dev-N`` in order,
+    each in file order; ``reserve`` requests are left out.
+
+    Raises:
+        ValueError: if there are no ``train`` requests, or the development splits are not
+            numbered 1 to N.
+    """
+    train = [r for r in rows if r.split == TRAIN_SPLIT]
+    devs: dict[int, list[CommandExample]] = {}
+    for r in rows:
+        if r.split.startswith(DEV_PREFIX):
+            devs.setdefault(int(r.split.removeprefix(DEV_PREFIX)), []).append(r)
+    if not train:
+        raise ValueError(f"no requests of split {TRAIN_SPLIT!r}")
+    if sorted(devs) != list(range(1, len(devs) + 1)):
+        numbers = ", ".join(map(str, sorted(devs)))
+        raise ValueError(f"development splits must be numbered 1 to N, got {numbers}")
+    return train, [devs[k] for k in sorted(devs)]

@@ -1,0 +1,198 @@
+"""LLM-1 shared pieces: the confirmation template, its parser, yes/no answers, results.
+
+The paper's template is ``You want me to [action], is this correct?`` with the action
+one of ``drive faster`` (fast, 0), ``drive more carefully`` (comfort, 1), ``stop`` (2).
+"""
+
+from __future__ import annotations
+
+import re
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+from explaindrive.commands import Command
+
+ACTION_PHRASES: dict[Command, str] = {
+    Command.FAST: "drive faster",
+    Command.COMFORT: "drive more carefully",
+    Command.STOP: "stop",
+}
+CONFIRMATION_TEMPLATE = "You want me to {action}, is this correct?"
+REPHRASE_MESSAGE = (
+    "Sorry, I can only change how I drive: faster, more carefully, or stop. "
+    "Could you rephrase your request?"
+)
+
+_CONFIRMATION_RE = re.compile(
+    r"You want me to (drive faster|drive more carefully|stop), is this correct\?"
+)
+_PHRASE_TO_COMMAND = {phrase: cmd for cmd, phrase in ACTION_PHRASES.items()}
+
+
+@dataclass(frozen=True, slots=True)
+class IntentResult:
+    """Outcome of interpreting one passenger request.
+
+    Attributes:
+        intent: the command, or ``None`` when the request is not about driving style.
+        confirmation: the template question for an intent, else a request to rephrase.
+        backend: name of the backend that produced the answer (``embedded``/``openai``).
+        fallback: ``True`` when the configured backend failed and ``embedded`` answered.
+        latency_s: wall time of the call [s].
+        scores: class probabilities when the backend exposes them (embedded), else empty.
+        error: why the configured backend was bypassed, when ``fallback`` is ``True``.
+        instruction: when the request corrects itself ("faster... no, stop"), the part
+            after its last repair marker that decided the command; else ``None``.
+        stop_lane: ``True`` when the embedded STOP check answered before any remote
+            model was asked (a STOP is never left waiting on an endpoint).
+        rule: with a remote model, the rule of :mod:`~explaindrive.language.intent.agreement`
+            that chose between its reading and the embedded one; else ``None``.
+        overruled: the remote model's reply was read but the embedded reading stood
+            against it (rules ``local-sure-none`` and ``local-sure``).
+        raw_reply: the remote model's reply as it came, for the ride log only (the
+            passenger sees ``confirmation``).
+        readings: when a remote reply was read, the two readings the agreement policy
+            chose between: ``(embedded reading, its probability, remote reading)``, a
+            reading ``None`` meaning "not a driving request"; else ``None``.
+    """
+
+    intent: Command | None
+    confirmation: str | None
+    backend: str
+    fallback: bool
+    latency_s: float
+    scores: dict[str, float]
+    error: str | None = None
+    instruction: str | None = None
+    stop_lane: bool = False
+    rule: str | None = None
+    overruled: bool = False
+    raw_reply: str | None = None
+    readings: tuple[Command | None, float, Command | None] | None = None
+
+    def to_json(self) -> dict[str, object]:
+        """The CLI's JSON shape."""
+        return {
+            "intent": self.intent.label if self.intent is not None else None,
+            "confirmation": self.confirmation,
+            "backend": self.backend,
+            "fallback": self.fallback,
+            "instruction": self.instruction,
+            "stop_lane": self.stop_lane,
+            "rule": self.rule,
+            "overruled": self.overruled,
+        }
+
+
+class IntentInterpreter(ABC):
+    """LLM-1: maps a passenger request to a command and a confirmation question."""
+
+    name: str = "abstract"
+
+    @abstractmethod
+    def interpret(self, text: str) -> IntentResult:
+        """Interpret one passenger request (never raises on odd text)."""
+
+
+def format_confirmation(command: Command) -> str:
+    """The paper's confirmation question for ``command``."""
+    return CONFIRMATION_TEMPLATE.format(action=ACTION_PHRASES[command])
+
+
+def parse_confirmation(text: str) -> Command | None:
+    """The command of a reply that follows the template exactly, else ``None``.
+
+    Surrounding white space and one pair of surrounding quotes are tolerated; any
+    other text (options, explanations, a second sentence) makes the reply invalid.
+    """
+    reply = text.strip()
+    if len(reply) >= 2 and reply[0] == reply[-1] and reply[0] in "\"'":
+        reply = reply[1:-1].strip()
+    match = _CONFIRMATION_RE.fullmatch(reply)
+    return _PHRASE_TO_COMMAND[match.group(1)] if match else None
+
+
+def is_template_compliant(text: str | None) -> bool:
+    """Whether ``text`` is exactly a template confirmation question."""
+    return text is not None and parse_confirmation(text) is not None
+
+
+_YES_PHRASES = (
+    "no problem",
+    "no worries",
+    "why not",
+    "of course",
+    "that's right",
+    "thats right",
+    "that is right",
+    "go ahead",
+    "do it",
+    "sounds good",
+    "please do",
+    "you got it",
+)
+_NO_PHRASES = (
+    "not correct",
+    "not right",
+    "isn't right",
+    "isnt right",
+    "that's wrong",
+    "thats wrong",
+    "don't",
+    "dont",
+    "do not",
+    "never mind",
+    "nevermind",
+    "not what i",
+)
+_YES_WORDS = frozenset(
+    {
+        "yes",
+        "yeah",
+        "yep",
+        "yup",
+        "ya",
+        "correct",
+        "right",
+        "sure",
+        "ok",
+        "okay",
+        "affirmative",
+        "absolutely",
+        "definitely",
+        "indeed",
+        "confirm",
+        "confirmed",
+        "exactly",
+        "perfect",
+        "fine",
+    }
+)
+_NO_WORDS = frozenset({"no", "nope", "nah", "not", "wrong", "incorrect", "cancel", "negative"})
+
+
+def parse_confirmation_answer(text: str) -> bool | None:
+    """Read the passenger's answer to a confirmation question.
+
+    Returns:
+        ``True`` for yes ("yes", "that's right", "sure, no problem"), ``False`` for no
+        ("no", "that's not correct", "cancel"), ``None`` when the answer is neither or
+        contradicts itself ("yes... no").
+    """
+    t = re.sub(r"[^a-z' ]+", " ", text.lower().replace("\u2019", "'"))
+    t = " " + re.sub(r"\s+", " ", t).strip() + " "
+    if any(f" {p} " in t for p in _NO_PHRASES):
+        return False
+    yes = False
+    for phrase in _YES_PHRASES:
+        if f" {phrase} " in t:
+            yes = True
+            t = t.replace(f" {phrase} ", " ")
+    words = set(t.split())
+    yes = yes or bool(words & _YES_WORDS)
+    no = bool(words & _NO_WORDS)
+    if yes and no:
+        return None
+    if no:
+        return False
+    return True if yes else None
