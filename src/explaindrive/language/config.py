@@ -10,6 +10,7 @@ from pydantic import AfterValidator, Field
 
 from explaindrive.config import LaxModel, read_yaml
 from explaindrive.language.backends.registry import check_backend
+from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M
 from explaindrive.language.intent.encoders import (
     DEFAULT_RUNTIME,
     EncoderRuntime,
@@ -18,8 +19,6 @@ from explaindrive.language.intent.encoders import (
 
 BackendName = Annotated[str, AfterValidator(check_backend)]
 """The name of a registered language backend (:mod:`explaindrive.language.backends`)."""
-
-SUMMARY_CUTOFF_M = 50.0  # [m] objects farther than this are left out of summaries and decisions
 
 
 class SpeechConfig(LaxModel):

@@ -6,16 +6,20 @@ attributes, and :meth:`Backend.build`, which returns the three modules the ride 
 the stack, the configs and the commands then take its name. An unknown name is one
 error naming the known ones. This module imports no model code: a backend imports its
 own in :meth:`~Backend.build`.
+
+Nor does it import the language config: the config checks its ``backend`` against this
+registry (:func:`check_backend`), so the registry stays below it and
+:meth:`Backend.build` takes the config untyped here (a backend annotates it as
+:class:`~explaindrive.language.config.LanguageConfig`).
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 if TYPE_CHECKING:
-    from explaindrive.language.config import LanguageConfig
     from explaindrive.language.explanation.decision import ExplanationDecider
     from explaindrive.language.explanation.explainer import Explainer
     from explaindrive.language.intent.interpreter import IntentInterpreter
@@ -55,8 +59,9 @@ class Backend(ABC):
     embedded module answers); a ride checks the deadline against its own."""
 
     @abstractmethod
-    def build(self, config: LanguageConfig) -> LanguageModules:
-        """The backend's modules, configured by ``config`` (models load on first use)."""
+    def build(self, config: Any) -> LanguageModules:
+        """The backend's modules, configured by ``config``, the layer's
+        :class:`~explaindrive.language.config.LanguageConfig` (models load on first use)."""
 
 
 B = TypeVar("B", bound=type[Backend])

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from explaindrive.commands import Command
-from explaindrive.language.config import SUMMARY_CUTOFF_M
 from explaindrive.language.explanation.hazards import (
     AT_LIMIT_MARGIN_MPS,
     COMFORT_DECEL_MPS2,
@@ -33,7 +32,7 @@ from explaindrive.language.explanation.hazards import (
     leader_is_hazard,
     stopping_distance_m,
 )
-from explaindrive.language.explanation.summary import RecordState, StateRecord
+from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M, RecordState, StateRecord
 
 __all__ = [
     "AT_LIMIT_MARGIN_MPS",

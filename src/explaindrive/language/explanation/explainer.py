@@ -7,9 +7,8 @@ import re
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
-from explaindrive.language.config import SUMMARY_CUTOFF_M
 from explaindrive.language.explanation.decision import Factor
-from explaindrive.language.explanation.summary import RecordState, StateRecord
+from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M, RecordState, StateRecord
 
 # Words that name each factor; used to check that a text is grounded in the state.
 _FACTOR_PATTERNS: dict[Factor, re.Pattern[str]] = {

@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import re
 
-from explaindrive.language.config import SUMMARY_CUTOFF_M
 from explaindrive.language.explanation.explainer import STANDSTILL_MPS, check_grounding
 from explaindrive.language.explanation.hazards import Factor
-from explaindrive.language.explanation.summary import RecordState, StateRecord
+from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M, RecordState, StateRecord
 
 MAX_EXPLANATION_CHARS = 400
 DISTANCE_TOLERANCE_M = 3.0  # [m] a distance in a text may differ this much from the state's

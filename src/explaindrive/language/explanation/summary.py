@@ -23,7 +23,6 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from explaindrive.commands import Command
 from explaindrive.env.state import SENSOR_RANGE_M, DrivingState, LightState
-from explaindrive.language.config import SUMMARY_CUTOFF_M
 from explaindrive.language.explanation.hazards import (
     Factor,
     Hazard,
@@ -39,6 +38,7 @@ _M = TypeVar("_M", bound=BaseModel)
 RequestLabel = Literal["fast", "comfort", "stop"]
 LightLabel = Literal["green", "yellow", "red"]
 
+SUMMARY_CUTOFF_M = 50.0  # [m] objects farther than this are left out of summaries and decisions
 RESIDENTIAL_LIMIT_MPS = 30 / 3.6 + 0.05  # [m/s] limits up to 30 km/h are treated as residential
 VIRTUAL_LEADER_TOL_M = 2.0  # [m] a leader this close to a stop line is the env's virtual leader
 
