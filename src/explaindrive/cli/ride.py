@@ -161,6 +161,19 @@ def ride(
     typed = _passenger_input(voice) if interactive else None
     if script is None and not interactive:
         console.print(f"default ride script: {default_script_path()}")
+    _drive_and_report(session, lines, staging, out, typed, live)
+
+
+def _drive_and_report(
+    session: RideSession,
+    lines: list[ScriptLine],
+    staging: Path,
+    out: Path,
+    typed: queue.Queue[PassengerInput | str] | None,
+    live: bool,
+) -> None:
+    """Drive the ride (:func:`_run`) and print its summary; exit with 128 + the signal's
+    number if a signal ended it."""
     outputs = _run(session, lines, staging, out, typed, live)
     _print_summary(session, outputs)
     if outputs.interrupted is not None:
