@@ -7,7 +7,10 @@ from collections.abc import Iterator
 
 import pytest
 
+from explaindrive.ride.inputs import TypedLine
+from explaindrive.ride.jobs import Interpretation, InterpretJob
 from explaindrive.ride.lane import LanguageLane
+from explaindrive.ride.records import PassengerRequest
 
 
 @pytest.fixture
@@ -19,13 +22,15 @@ def lane() -> Iterator[LanguageLane]:
 
 
 def test_results_errors_and_late_tasks(lane: LanguageLane) -> None:
-    lane.submit("interpret", lambda x: x * 2, 21, deadline_s=1.0, context={"id": 1})
+    job = InterpretJob(PassengerRequest(1, 0.0, TypedLine("  "), None))
+    empty = Interpretation("  ", None, 0.0, "empty request")
+    lane.submit("interpret", lambda x: x, empty, deadline_s=1.0, context=job)
     lane.submit("decide", lambda: 1 / 0, deadline_s=1.0)
     lane.submit("explain", time.sleep, 0.3, deadline_s=0.05)
     outcomes = lane.collect(wait=True)
     assert [o.task.kind for o in outcomes] == ["interpret", "decide", "explain"]
     ok, failed, late = outcomes
-    assert ok.result == 42 and ok.error is None and ok.task.context == {"id": 1}
+    assert ok.result is empty and ok.error is None and ok.task.context is job
     assert failed.error == "ZeroDivisionError: division by zero"
     assert late.late and late.latency_s >= 0.05
     assert lane.pending == 0

@@ -20,14 +20,15 @@ def test_yaml_script_is_sorted_and_resolves_audio(tmp_path):
     )
     lines = load_script(path)
     assert [ln.t for ln in lines] == [0.0, 30.0]
-    assert lines[0].say == "hurry" and lines[0].confirm == "yes"
+    assert lines[0].say == "hurry" and lines[0].confirm == "yes" and lines[0].answer is True
+    assert lines[1].confirm is None and lines[1].answer is None
     assert lines[1].audio == tmp_path / "a.wav"
 
 
 def test_json_script_with_lines_key(tmp_path):
     path = write(tmp_path, "s.json", '{"lines": [{"t": 5, "say": "stop", "confirm": "no"}]}')
     (line,) = load_script(path)
-    assert (line.t, line.say, line.confirm) == (5.0, "stop", "no")
+    assert (line.t, line.say, line.confirm, line.answer) == (5.0, "stop", "no", False)
 
 
 def test_default_script_exercises_fast_stop_comfort():

@@ -11,6 +11,7 @@ from explaindrive.commands import Command
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
+from explaindrive.ride.inputs import TypedLine
 from explaindrive.ride.runner import run_ride
 from explaindrive.ride.script import ScriptLine
 from explaindrive.ride.session import RideSession, check_deadlines
@@ -85,11 +86,28 @@ def test_unconfirmed_question_waits_for_the_passenger():
     session.step()
     assert session.pending_confirmation is not None
     assert session.pending_confirmation.question == "You want me to stop, is this correct?"
+    assert session.pending_confirmation.line == TypedLine("stop please")
+    assert session.pending_confirmation.confirm is None
     assert session.command is Command.FAST
     assert session.answer(True)
     session.step()
     assert session.records[-1].command == "stop"
     assert not session.answer(False)  # nothing pending any more
+    session.close()
+
+
+def test_a_scripted_no_cancels_and_a_yes_no_string_is_refused():
+    session = make_session(max_steps=30)
+    session.start()
+    session.say("stop please", confirm=False)
+    session.step()
+    session.step()
+    assert session.pending_confirmation is None and session.command is Command.FAST
+    (cancelled,) = events(session, "cancelled")
+    assert (cancelled["source"], cancelled["kept_command"]) == ("script", "fast")
+    with pytest.raises(TypeError, match="confirm must be True, False or None, got 'no'"):
+        session.say("stop please", confirm="no")  # type: ignore[arg-type]
+    assert session.counts.requests == 1
     session.close()
 
 
@@ -157,8 +175,8 @@ def test_a_later_request_understood_first_wins():
     """'hurry (slow model)' then 'stop': the stop is read first; the older fast is dropped."""
     session = make_session(realtime=True, max_steps=20)
     session.start()
-    session.say("hurry, slow model", confirm="yes")  # read in 0.5 s
-    session.say("stop", confirm="yes")  # read at once, in a worker of its own
+    session.say("hurry, slow model", confirm=True)  # read in 0.5 s
+    session.say("stop", confirm=True)  # read at once, in a worker of its own
     time.sleep(0.2)
     session.step()
     assert session.command is Command.STOP

@@ -16,7 +16,7 @@ from explaindrive.language.explanation.explainer import Explanation
 from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.jobs import DecideJob, ExplainJob
-from explaindrive.ride.lane import EXPLANATION, LanguageLane, Outcome, TaskKind
+from explaindrive.ride.lane import EXPLANATION, LanguageLane, TaskKind
 from explaindrive.ride.records import RideCounts, StepRecord
 
 if TYPE_CHECKING:
@@ -64,9 +64,9 @@ class Explanations:
             context=DecideJob(state_record, len(self.records) - 1),
         )
 
-    def on_decision(self, job: DecideJob, out: Outcome) -> None:
-        """Record LLM-2's decision; ask LLM-3 when it says explain, outside the cool-down."""
-        decision: Decision = out.result
+    def on_decision(self, job: DecideJob, decision: Decision, latency_s: float) -> None:
+        """Record LLM-2's decision (its task took ``latency_s`` [s]); ask LLM-3 when it says
+        explain, outside the cool-down."""
         rec = self.records[job.step]
         factor = decision.factor.value if decision.factor is not None else None
         rec.decision = {
@@ -74,11 +74,11 @@ class Explanations:
             "factor": factor,
             "backend": decision.backend,
             "fallback": decision.fallback,
-            "latency_s": round(out.latency_s, 4),
+            "latency_s": round(latency_s, 4),
         }
         if decision.raw_reply is not None:  # the ride log keeps what the model said
             rec.decision.update(vetoed=decision.vetoed, raw_reply=decision.raw_reply)
-        rec.latency_s["decide"] = out.latency_s
+        rec.latency_s["decide"] = latency_s
         self.counts.fallbacks += int(decision.fallback)
         if not decision.explain:
             return
@@ -98,20 +98,19 @@ class Explanations:
             context=ExplainJob(job.step),
         )
 
-    def on_explanation(self, job: ExplainJob, out: Outcome) -> None:
-        """Write LLM-3's explanation into its step's record."""
-        exp: Explanation = out.result
+    def on_explanation(self, job: ExplainJob, exp: Explanation, latency_s: float) -> None:
+        """Write LLM-3's explanation (its task took ``latency_s`` [s]) into its step's record."""
         rec = self.records[job.step]
         rec.explanation = {
             "text": exp.text,
             "factor": exp.factor.value if exp.factor is not None else None,
             "backend": exp.backend,
             "fallback": exp.fallback,
-            "latency_s": round(out.latency_s, 4),
+            "latency_s": round(latency_s, 4),
         }
         if exp.raw_reply is not None:
             rec.explanation["raw_reply"] = exp.raw_reply
-        rec.latency_s["explain"] = out.latency_s
+        rec.latency_s["explain"] = latency_s
         self.counts.explanations += 1
         self.counts.fallbacks += int(exp.fallback)
         self.latest = {"t": rec.t, **rec.explanation}

@@ -1,7 +1,11 @@
-"""The ride's language jobs, one typed record each, and the typed result of interpreting.
+"""The ride's language jobs, one typed record each, and the typed results of their tasks.
 
 A job travels with its task through the language lane (:mod:`explaindrive.ride.lane`);
-when the task comes back, the ride hands its outcome to the job's owner by the job's type.
+when the task comes back, the ride hands its result to the job's owner by the job's type:
+an :class:`Interpretation` for an :class:`InterpretJob`, a
+:class:`~explaindrive.language.explanation.decision.Decision` for a :class:`DecideJob`, an
+:class:`~explaindrive.language.explanation.explainer.Explanation` for an
+:class:`ExplainJob`.
 """
 
 from __future__ import annotations
@@ -9,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from explaindrive.language.explanation.decision import Decision
+from explaindrive.language.explanation.explainer import Explanation
 from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.language.intent.interpreter import IntentResult
 from explaindrive.ride.records import PassengerRequest
@@ -51,3 +57,7 @@ class Interpretation(NamedTuple):
     """[s] wall time of the transcription (0 for a typed line)."""
     problem: str | None
     """Why there is no text (an unreadable recording, an empty request), else ``None``."""
+
+
+LanguageResult = Interpretation | Decision | Explanation
+"""What a language job's task returns (LLM-1, LLM-2, LLM-3)."""

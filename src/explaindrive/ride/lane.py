@@ -8,7 +8,9 @@ the passenger's requests:
 * ``explanation`` (LLM-2 and LLM-3): one worker, its tasks in order.
 
 The control loop polls for finished tasks; a task that misses its deadline is reported
-as late and its result, if it ever comes, is dropped.
+as late and its result, if it ever comes, is dropped. A task carries the ride's typed job
+(:data:`~explaindrive.ride.jobs.LanguageJob`) and returns a typed result
+(:data:`~explaindrive.ride.jobs.LanguageResult`).
 """
 
 from __future__ import annotations
@@ -16,9 +18,11 @@ from __future__ import annotations
 import concurrent.futures as cf
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
+
+from explaindrive.ride.jobs import LanguageJob, LanguageResult
 
 INTERPRETATION = "interpretation"
 EXPLANATION = "explanation"
@@ -42,16 +46,19 @@ CHANNELS: dict[TaskKind, str] = {
 """The channel of each kind of task."""
 INTERPRETATION_WORKERS = 4  # lines interpreted at the same time before one has to wait
 
+Finished = tuple[LanguageResult | None, str | None, float]
+"""What a worker hands back: the result, the error message, the monotonic finish time [s]."""
+
 
 @dataclass
 class Task:
     """A piece of language work."""
 
     kind: TaskKind
-    future: cf.Future[Any]
+    future: cf.Future[Finished]
     submitted: float  # [s] monotonic wall time
     deadline_s: float  # [s] allowed wall time
-    context: Any = field(default_factory=dict)
+    context: LanguageJob | None = None
     """What the submitter needs back with the result (a ride's typed job)."""
 
     @property
@@ -70,7 +77,8 @@ class Outcome:
     """A finished (or late, or failed) task."""
 
     task: Task
-    result: Any = None
+    result: LanguageResult | None = None
+    """``None`` when the task was late or failed."""
     error: str | None = None
     late: bool = False
     latency_s: float = 0.0
@@ -113,10 +121,10 @@ class LanguageLane:
     def submit(
         self,
         kind: TaskKind | str,
-        fn: Callable[..., Any],
+        fn: Callable[..., LanguageResult],
         *args: Any,
         deadline_s: float,
-        context: Any = None,
+        context: LanguageJob | None = None,
     ) -> Task:
         """Queue ``fn(*args)`` in the channel of ``kind``; it must finish within
         ``deadline_s`` wall seconds.
@@ -130,7 +138,7 @@ class LanguageLane:
         task_kind = TaskKind(kind)
         submitted = time.monotonic()  # before the worker can start
         future = self._pools[CHANNELS[task_kind]].submit(_run, fn, args)
-        task = Task(task_kind, future, submitted, deadline_s, {} if context is None else context)
+        task = Task(task_kind, future, submitted, deadline_s, context)
         self._pending.append(task)
         return task
 
@@ -177,7 +185,7 @@ def _finished(task: Task) -> Outcome:
     return Outcome(task, result=value, error=error, latency_s=latency)
 
 
-def _run(fn: Callable[..., Any], args: tuple[Any, ...]) -> tuple[Any, str | None, float]:
+def _run(fn: Callable[..., LanguageResult], args: tuple[Any, ...]) -> Finished:
     """Run ``fn``; return (result, error message, monotonic finish time); never raises."""
     try:
         value = fn(*args)

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from explaindrive.commands import Command
+from explaindrive.ride.inputs import PassengerInput
 
 
 @dataclass
@@ -14,10 +14,11 @@ class PassengerRequest:
     """A passenger line on its way to becoming a command."""
 
     id: int
-    t: float
-    text: str | None
-    audio: Path | None
-    confirm: str | None  # scripted answer: "yes" / "no" / None
+    t: float  # [s] ride time
+    line: PassengerInput
+    confirm: bool | None
+    """The scripted answer to the confirmation question (yes: ``True``); ``None`` leaves it to
+    the ride's settings or the passenger."""
     intent: Command | None = None
     question: str | None = None
 

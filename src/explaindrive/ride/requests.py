@@ -1,24 +1,25 @@
 """The passenger's requests: from a line to a confirmed command.
 
-A line is transcribed (when spoken) and interpreted (LLM-1) in the language lane; a
-command read from it is confirmed (by the passenger, the script or the ride's settings)
-before the car follows it. A confirmed command goes to the controller, which drives by it,
-and to the environment, which rewards and measures by it.
+A line (:data:`~explaindrive.ride.inputs.PassengerInput`, typed or spoken) is transcribed
+(when spoken) and interpreted (LLM-1) in the language lane; a command read from it is
+confirmed (by the passenger, the script or the ride's settings) before the car follows it.
+A confirmed command goes to the controller, which drives by it, and to the environment,
+which rewards and measures by it.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from explaindrive.commands import Command
 from explaindrive.language.speech.transcriber import AudioError
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
+from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
 from explaindrive.ride.jobs import Interpretation, InterpretJob
-from explaindrive.ride.lane import LanguageLane, Outcome, TaskKind
+from explaindrive.ride.lane import LanguageLane, TaskKind
 from explaindrive.ride.records import PassengerRequest, RideCounts
 
 if TYPE_CHECKING:
@@ -69,26 +70,36 @@ class PassengerRequests:
         self._requests = 0
         self._newest_read = 0  # the latest request understood as a command
 
-    def submit(self, text: str | None, audio: Path | None, confirm: str | None) -> int:
-        """Queue a line for interpretation; returns its request id."""
+    def submit(self, line: PassengerInput, confirm: bool | None = None) -> int:
+        """Queue a line for interpretation; returns its request id.
+
+        Args:
+            line: what the passenger typed or spoke.
+            confirm: the scripted answer to the confirmation question; ``None`` leaves it to
+                the ride's settings or the passenger.
+
+        Raises:
+            TypeError: if ``confirm`` is not a bool or ``None`` (a "yes"/"no" string would
+                read as yes either way).
+        """
+        if confirm is not None and not isinstance(confirm, bool):
+            raise TypeError(f"confirm must be True, False or None, got {confirm!r}")
         self._requests += 1
-        req = PassengerRequest(self._requests, self._clock(), text, audio, confirm)
+        req = PassengerRequest(self._requests, self._clock(), line, confirm)
         self.counts.requests += 1
-        self._note(
-            {
-                "type": EventType.LINE,
-                "id": req.id,
-                "text": text,
-                "audio": str(audio) if audio else None,
-            }
-        )
+        text: str | None = None
+        audio: str | None = None
+        match line:
+            case TypedLine(typed):
+                text, deadline_s = typed, self.config.interpret_deadline_s
+            case SpokenLine(path):
+                audio, deadline_s = str(path), self.config.audio_deadline_s
+        self._note({"type": EventType.LINE, "id": req.id, "text": text, "audio": audio})
         self.lane.submit(
             TaskKind.INTERPRET,
             self._interpret,
             req,
-            deadline_s=(
-                self.config.audio_deadline_s if audio else self.config.interpret_deadline_s
-            ),
+            deadline_s=deadline_s,
             context=InterpretJob(req),
         )
         return req.id
@@ -104,25 +115,31 @@ class PassengerRequests:
 
     def _interpret(self, req: PassengerRequest) -> Interpretation:
         """Worker side: transcribe if needed, then interpret."""
-        transcript_s = 0.0
-        text = req.text or ""
-        if req.audio is not None:
-            t0 = time.perf_counter()
-            try:
-                text = self.language.transcriber.transcribe(req.audio).text
-            except AudioError as exc:
-                return Interpretation("", None, time.perf_counter() - t0, str(exc))
-            transcript_s = time.perf_counter() - t0
+        match req.line:
+            case TypedLine(text):
+                transcript_s = 0.0
+            case SpokenLine(audio):
+                t0 = time.perf_counter()
+                try:
+                    text = self.language.transcriber.transcribe(audio).text
+                except AudioError as exc:
+                    return Interpretation("", None, time.perf_counter() - t0, str(exc))
+                transcript_s = time.perf_counter() - t0
         if not text.strip():
             return Interpretation(text, None, transcript_s, "empty request")
         return Interpretation(text, self.language.interpreter.interpret(text), transcript_s, None)
 
-    def on_interpretation(self, job: InterpretJob, out: Outcome) -> None:
-        """Log what was heard and understood; confirm the command or ask the question."""
+    def on_interpretation(self, job: InterpretJob, heard: Interpretation, latency_s: float) -> None:
+        """Log what was heard and understood; confirm the command or ask the question.
+
+        Args:
+            job: the interpreted request's job.
+            heard: what the interpretation worker returned.
+            latency_s: the task's wall time [s].
+        """
         req = job.request
-        heard: Interpretation = out.result
         result = heard.result
-        if req.audio is not None:
+        if isinstance(req.line, SpokenLine):
             self._note(
                 {
                     "type": EventType.TRANSCRIPT,
@@ -148,7 +165,7 @@ class PassengerRequests:
                 "type": EventType.INTERPRETATION,
                 "id": req.id,
                 **result.to_json(),
-                "latency_s": round(out.latency_s, 4),
+                "latency_s": round(latency_s, 4),
                 "error": result.error,
                 "raw_reply": result.raw_reply,  # for the log; the page drops it
             }
@@ -167,7 +184,7 @@ class PassengerRequests:
         if result.intent is Command.STOP and self.config.stop_without_confirm:
             self._resolve(req, True, source="stop-without-confirm")
         elif req.confirm is not None:
-            self._resolve(req, req.confirm == "yes", source="script")
+            self._resolve(req, req.confirm, source="script")
         elif self.config.auto_confirm:
             self._resolve(req, True, source="auto")
         else:

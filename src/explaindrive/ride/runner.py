@@ -249,7 +249,7 @@ def _drive(
         tick = time.monotonic()
         while todo and todo[0].t <= session.t:
             line = todo.popleft()
-            session.hear(line.line, confirm=line.confirm)
+            session.hear(line.line, confirm=line.answer)
         _drain_typed(session, typed, held)
         rec = session.step()
         if on_step is not None:

@@ -53,6 +53,12 @@ class ScriptLine(LaxModel):
         return self
 
     @property
+    def answer(self) -> bool | None:
+        """The scripted answer to the confirmation question: ``True`` for yes, ``False``
+        for no, ``None`` when the line has none."""
+        return None if self.confirm is None else self.confirm == "yes"
+
+    @property
     def line(self) -> PassengerInput:
         """What the passenger says: the recording, else the typed text."""
         if self.audio is not None:

@@ -26,12 +26,14 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import speed_change
 from explaindrive.env.metrics import EpisodeMetrics
 from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.language.explanation.decision import Decision
+from explaindrive.language.explanation.explainer import Explanation
 from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
 from explaindrive.ride.explaining import Explanations
 from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
-from explaindrive.ride.jobs import DecideJob, ExplainJob, InterpretJob
+from explaindrive.ride.jobs import DecideJob, ExplainJob, Interpretation, InterpretJob
 from explaindrive.ride.lane import LanguageLane, Outcome, TaskKind
 from explaindrive.ride.records import PassengerRequest, RideCounts, StepRecord
 from explaindrive.ride.requests import PassengerRequests
@@ -144,21 +146,24 @@ class RideSession:
         return self.controller.command
 
     # ------------------------------------------------------------------ passenger input
-    def say(self, text: str, confirm: str | None = None) -> int:
-        """A typed passenger line; returns its request id."""
-        return self.requests.submit(text=text, audio=None, confirm=confirm)
+    def hear(self, line: PassengerInput, confirm: bool | None = None) -> int:
+        """A passenger line, typed or spoken; returns its request id.
 
-    def say_audio(self, path: str | Path, confirm: str | None = None) -> int:
-        """A spoken passenger line (a WAV/FLAC/MP3 file); returns its request id."""
-        return self.requests.submit(text=None, audio=Path(path), confirm=confirm)
+        Args:
+            line: what the passenger typed or spoke.
+            confirm: the scripted answer to the confirmation question (yes: ``True``);
+                ``None`` leaves it to the ride's settings or the passenger.
+        """
+        return self.requests.submit(line, confirm)
 
-    def hear(self, line: PassengerInput, confirm: str | None = None) -> int:
-        """A passenger line, typed or spoken; returns its request id."""
-        match line:
-            case TypedLine(text):
-                return self.say(text, confirm=confirm)
-            case SpokenLine(audio):
-                return self.say_audio(audio, confirm=confirm)
+    def say(self, text: str, confirm: bool | None = None) -> int:
+        """A typed passenger line (:meth:`hear` of a :class:`TypedLine`)."""
+        return self.hear(TypedLine(text), confirm)
+
+    def say_audio(self, path: str | Path, confirm: bool | None = None) -> int:
+        """A spoken passenger line, a WAV/FLAC/MP3 file (:meth:`hear` of a
+        :class:`SpokenLine`)."""
+        return self.hear(SpokenLine(Path(path)), confirm)
 
     def answer(self, yes: bool) -> bool:
         """Answer the pending confirmation question; ``False`` if none was pending."""
@@ -229,13 +234,17 @@ class RideSession:
             if out.late or out.error:
                 self._note_missed(out)
                 continue
-            match out.task.context:
-                case InterpretJob() as job:
-                    self.requests.on_interpretation(job, out)
-                case DecideJob() as job:
-                    self.explanations.on_decision(job, out)
-                case ExplainJob() as job:
-                    self.explanations.on_explanation(job, out)
+            match out.task.context, out.result:
+                case InterpretJob() as job, Interpretation() as heard:
+                    self.requests.on_interpretation(job, heard, out.latency_s)
+                case DecideJob() as job, Decision() as decision:
+                    self.explanations.on_decision(job, decision, out.latency_s)
+                case ExplainJob() as job, Explanation() as explanation:
+                    self.explanations.on_explanation(job, explanation, out.latency_s)
+                case job, result:
+                    raise TypeError(
+                        f"{type(job).__name__} came back with a {type(result).__name__}"
+                    )
 
     def _note_missed(self, out: Outcome) -> None:
         """Log a task that came back late or failed; the car keeps its command."""

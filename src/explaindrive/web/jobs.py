@@ -10,12 +10,12 @@ from __future__ import annotations
 import logging
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Protocol
 
 from explaindrive.commands import Command
 from explaindrive.redact import redact
 from explaindrive.ride.config import RideConfig
+from explaindrive.ride.inputs import PassengerInput, SpokenLine
 from explaindrive.ride.session import RideSession
 from explaindrive.web.board import RideBoard, RideState
 from explaindrive.web.models import StartRequest
@@ -161,31 +161,22 @@ class Reset(RideJob):
 
 
 @dataclass(frozen=True)
-class Say(RideJob):
-    """A typed passenger line."""
+class Hear(RideJob):
+    """A passenger line from the page: typed, or recorded and stored in an upload file."""
 
-    text: str
-
-    def run(self, ride: RideWorker) -> dict[str, Any]:
-        """Hand the line to the ride; answers its request id."""
-        return {"id": ride.active_session().say(self.text)}
-
-
-@dataclass(frozen=True)
-class Audio(RideJob):
-    """A recorded passenger line, stored at ``path``."""
-
-    path: Path
+    line: PassengerInput
 
     def run(self, ride: RideWorker) -> dict[str, Any]:
-        """Hand the recording to the ride (:class:`RideBusyError` when too many wait)."""
+        """Hand the line to the ride (:meth:`RideSession.hear`, as the terminal's lines);
+        answers its request id (:class:`RideBusyError` when too many recordings wait)."""
         session = ride.active_session()
-        if ride.uploads.waiting() >= MAX_WAITING_UPLOADS:
-            raise RideBusyError(
-                f"{MAX_WAITING_UPLOADS} recordings are still being transcribed; try again soon"
-            )
-        ride.uploads.add(self.path)
-        return {"id": session.say_audio(self.path)}
+        if isinstance(self.line, SpokenLine):
+            if ride.uploads.waiting() >= MAX_WAITING_UPLOADS:
+                raise RideBusyError(
+                    f"{MAX_WAITING_UPLOADS} recordings are still being transcribed; try again soon"
+                )
+            ride.uploads.add(self.line.audio)
+        return {"id": session.hear(self.line)}
 
 
 @dataclass(frozen=True)

@@ -18,10 +18,11 @@ from fastapi.responses import HTMLResponse
 from starlette.datastructures import UploadFile
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
+from explaindrive.ride.inputs import SpokenLine, TypedLine
 from explaindrive.web.audio import AudioRejectedError, decode_bounded, read_upload, wav_bytes
 from explaindrive.web.jobs import (
     Answer,
-    Audio,
+    Hear,
     Pause,
     Reset,
     Resume,
@@ -29,7 +30,6 @@ from explaindrive.web.jobs import (
     RideConflictError,
     RideJob,
     RideStartError,
-    Say,
     Start,
 )
 from explaindrive.web.manager import RideManager
@@ -131,7 +131,7 @@ async def reset(manager: Manager) -> dict[str, Any]:
 @ride_router.post("/say", status_code=202)
 async def say(body: SayRequest, manager: Manager) -> dict[str, Any]:
     """A typed passenger line; it is interpreted while the ride goes on."""
-    return await run_job(manager, Say(body.text))
+    return await run_job(manager, Hear(TypedLine(body.text)))
 
 
 @ride_router.post("/audio", status_code=202)
@@ -148,7 +148,7 @@ async def audio(request: Request, manager: Manager) -> dict[str, Any]:
     path = manager.new_upload_path(".wav")
     path.write_bytes(wav_bytes(samples))
     try:
-        return await run_job(manager, Audio(path))
+        return await run_job(manager, Hear(SpokenLine(path)))
     except HTTPException:
         path.unlink(missing_ok=True)
         raise
