@@ -9,10 +9,19 @@ import pytest
 
 from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
 from explaindrive.language.config import LanguageConfig
-from explaindrive.language.data import BLIND_CSV, DECISIONS_JSONL, TEST_CSV, TRAIN_CSV, data_path
+from explaindrive.language.data import (
+    BLIND_CSV,
+    DECISIONS_JSONL,
+    HELDOUT_CSV,
+    TEST_CSV,
+    TRAIN_CSV,
+    WRITTEN_CSV,
+    data_path,
+)
 from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
 from explaindrive.language.explanation.datasets import load_decisions
 from explaindrive.language.explanation.explainer import present_factors
+from explaindrive.language.intent.corpus import read_lines
 from explaindrive.language.intent.datasets import (
     RESERVE_SPLIT,
     CommandExample,
@@ -29,7 +38,7 @@ def _texts(rows: list[CommandExample]) -> set[str]:
 
 def _balanced(rows: list[CommandExample], kinds: set[str]) -> None:
     counts = Counter(r.label for r in rows)
-    assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 40 and counts["none"] >= 20
+    assert min(counts["fast"], counts["comfort"], counts["stop"]) >= 30 and counts["none"] >= 20
     assert kinds <= {r.kind for r in rows}
 
 
@@ -47,6 +56,35 @@ def test_training_file_splits() -> None:
     for i, a in enumerate(splits):
         for b in splits[i + 1 :]:
             assert a.isdisjoint(b)
+
+
+def _near_pairs(tests: list[str], seen: set[str]) -> list[tuple[str, str]]:
+    """The (test, seen) pairs that are near-copies: difflib's ratio, which is not symmetric,
+    at least :data:`NEAR_COPY` either way round. One matcher per second sequence, whose
+    tables difflib caches, keeps this to seconds."""
+    near = set()
+    for firsts, seconds, flip in ((tests, seen, False), (seen, tests, True)):
+        for b in seconds:
+            m = SequenceMatcher(None, "", b)
+            for a in firsts:
+                if 2 * min(len(a), len(b)) < NEAR_COPY * (len(a) + len(b)):
+                    continue  # real_quick_ratio from the lengths alone
+                m.set_seq1(a)
+                if m.quick_ratio() >= NEAR_COPY and m.ratio() >= NEAR_COPY:
+                    near.add((b, a) if flip else (a, b))
+    return sorted(near)
+
+
+def test_the_test_split_and_no_training_line_near_it() -> None:
+    heldout = load_commands(data_path(HELDOUT_CSV))
+    by_label = Counter(r.label for r in heldout)
+    assert len(heldout) == 382
+    assert by_label == {"fast": 79, "comfort": 77, "stop": 79, "none": 147}
+    negated = [r for r in heldout if r.kind == "negated_stop"]
+    assert len(negated) == 27 and "stop" not in {r.label for r in negated}
+    trained = _texts(load_commands(data_path(TRAIN_CSV)))
+    trained |= {r["text"].lower() for r in read_lines(data_path(WRITTEN_CSV))}
+    assert _near_pairs([t.text.lower() for t in heldout], trained) == []
 
 
 def test_blind_test_file() -> None:
