@@ -54,12 +54,16 @@ def test_interpret_json_and_bad_backend(interpreter) -> None:  # type: ignore[no
         "confirmation": "You want me to stop, is this correct?",
         "backend": "embedded",
         "fallback": False,
-        "instruction": None,
         "stop_lane": False,
         "rule": None,
         "overruled": False,
+        "reading": "stop",
         "error": None,
     }
+    res = runner.invoke(app, ["interpret", "Why are we slowing down?", "--json"])
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.stdout)
+    assert (out["intent"], out["reading"]) == (None, "why")  # a question, not a command
     res = runner.invoke(app, ["interpret", "hi", "--backend", "gpt9"])
     assert res.exit_code == 2 and "unknown language backend" in res.output
 

@@ -67,7 +67,8 @@ class ScriptedController:
 
 
 class KeywordInterpreter(IntentInterpreter):
-    """Maps keywords to commands; ``slow`` in the text makes it sleep, ``crash`` raise."""
+    """Maps keywords to commands, ``yes`` / ``no`` alone to answers; ``slow`` in the text
+    makes it sleep, ``crash`` raise."""
 
     name = "fake"
     words: ClassVar[dict[str, Command]] = {
@@ -84,9 +85,13 @@ class KeywordInterpreter(IntentInterpreter):
             raise RuntimeError("model exploded")
         if "slow" in text:
             time.sleep(self.delay_s)
+        if text.strip().lower() in ("yes", "no"):
+            answer = text.strip().lower()
+            return IntentResult(None, "Rephrase?", self.name, False, 0.0, {}, reading=answer)
         intent = next((c for w, c in self.words.items() if w in text.lower()), None)
         question = format_confirmation(intent) if intent is not None else "Could you rephrase?"
-        return IntentResult(intent, question, self.name, False, 0.0, {})
+        reading = intent.label if intent is not None else "none"
+        return IntentResult(intent, question, self.name, False, 0.0, {}, reading=reading)
 
 
 class BrakingDecider(ExplanationDecider):

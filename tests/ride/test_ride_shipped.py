@@ -66,7 +66,9 @@ def test_spoken_lines_go_through_whisper(language: LanguageStack, tmp_path: Path
             t=0, audio=speak("Please hurry up, I am late for my flight.", "hurry"), confirm="yes"
         ),
         ScriptLine(t=20, audio=silent),
-        ScriptLine(t=30, audio=speak("Stop the car right now.", "stop"), confirm="yes"),
+        # (espeak's "Stop the car right now." reaches Whisper tiny.en as "Stop looking alright
+        # now.", which LLM-1 reads as an unsure fast: docs/language.md)
+        ScriptLine(t=30, audio=speak("Pull over right now.", "stop"), confirm="yes"),
     ]
     session = RideSession(
         RideConfig(max_steps=45, seed=1), MergedController.from_package(), language

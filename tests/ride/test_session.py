@@ -96,6 +96,44 @@ def test_unconfirmed_question_waits_for_the_passenger():
     session.close()
 
 
+def test_a_line_read_as_yes_answers_the_question_and_one_read_as_no_cancels():
+    session = make_session(max_steps=30)
+    session.start()
+    session.say("stop please")
+    session.step()
+    session.step()
+    assert session.pending_confirmation is not None
+    session.say("yes")  # LLM-1 reads it as an answer, not a request
+    session.step()
+    session.step()
+    assert session.pending_confirmation is None
+    assert session.records[-1].command == "stop"
+    session.say("hurry")
+    session.step()
+    session.step()
+    session.say("no")
+    session.step()
+    session.step()
+    assert session.pending_confirmation is None
+    assert session.records[-1].command == "stop"  # cancelled: the STOP stands
+    assert session.counts.cancellations == 1
+    session.close()
+
+
+def test_an_answer_read_before_its_question_waits_for_it():
+    session = make_session(max_steps=60)
+    session.start()
+    session.say("stop, slowly")  # "slow": interpreted in 0.5 s
+    session.say("yes")  # read at once, while the request is still being interpreted
+    for _ in range(40):
+        session.step()
+        time.sleep(0.05)
+    assert session.pending_confirmation is None
+    assert session.records[-1].command == "stop"
+    assert [e["to"] for e in events(session, "confirmed")] == ["stop"]
+    session.close()
+
+
 def test_a_scripted_no_cancels_and_a_yes_no_string_is_refused():
     session = make_session(max_steps=30)
     session.start()

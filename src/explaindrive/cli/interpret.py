@@ -55,6 +55,8 @@ def interpret_command(
     if transcript is not None:
         console.print(f"[dim]heard:[/] {transcript.text}", highlight=False)
     intent = out["intent"] or "none"
+    if result.intent is None and result.reading not in (None, "none"):
+        intent = f"none (reading: {result.reading})"  # a why question or a yes / no answer
     note = " [yellow](fallback)[/]" if result.fallback else ""
     note += " [dim](offline STOP check)[/]" if result.stop_lane else ""
     console.print(f"[bold]{intent}[/] via {result.backend}{note}", highlight=False)

@@ -1,4 +1,5 @@
-"""``explaindrive score intents|decisions``: score LLM-1 and LLM-2/LLM-3 on labelled data."""
+"""``explaindrive score intents|everyday|decisions``: score LLM-1 on labelled requests and
+on everyday talk, LLM-2/LLM-3 on labelled state records."""
 
 from __future__ import annotations
 
@@ -26,7 +27,8 @@ score_app = typer.Typer(
     add_completion=False,
 )
 # the shipped files (explaindrive.language.data), named without importing the readers
-SHIPPED_COMMANDS = "the shipped commands_test.csv"
+SHIPPED_COMMANDS = "the shipped test split commands_heldout.csv"
+SHIPPED_EVERYDAY = "the shipped external check everyday_check.csv.gz"
 SHIPPED_DECISIONS = "the shipped decisions.jsonl"
 
 
@@ -59,11 +61,11 @@ def intents_command(
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1; with a
     remote model, also the figures each trust_embedded_from would give on its replies."""
-    from explaindrive.language.data import TEST_CSV, data_path
+    from explaindrive.language.data import HELDOUT_CSV, data_path
     from explaindrive.language.intent.datasets import load_commands
 
     refuse_bad_outputs(files=((out, "--json"),))
-    data = data or data_path(TEST_CSV)
+    data = data or data_path(HELDOUT_CSV)
     try:
         rows = load_commands(data)
         if split is not None:
@@ -80,19 +82,34 @@ def intents_command(
     report = evaluate_intents(stack.interpreter, rows)
     report.update(backend=stack.backend, data=str(data), split=split)
     where = data.name if split is None else f"{data.name}, split {split}"
-    table = Table(title=f"LLM-1 on {where} ({stack.backend})")
-    for col in ("class", "precision", "recall", "F1", "support"):
-        table.add_column(col, justify="right")
-    for name, m in report["per_class"].items():
-        table.add_row(
-            name, f"{m['precision']:.3f}", f"{m['recall']:.3f}", f"{m['f1']:.3f}", str(m["support"])
-        )
-    console.print(table)
+    _print_intents(report, f"LLM-1 on {where} ({stack.backend})")
+    _write(out, report)
+
+
+def _print_intents(report: dict[str, Any], title: str) -> None:
+    """The per-class table, the summary line, the replies and the trust sweep."""
+    if report["per_class"]:
+        table = Table(title=title)
+        for col in ("class", "precision", "recall", "F1", "support"):
+            table.add_column(col, justify="right")
+        for name, m in report["per_class"].items():
+            table.add_row(
+                name,
+                f"{m['precision']:.3f}",
+                f"{m['recall']:.3f}",
+                f"{m['f1']:.3f}",
+                str(m["support"]),
+            )
+        console.print(table)
+    else:
+        console.print(f"{title}: no command rows, off-topic figures only")
     console.print(
-        f"accuracy {report['accuracy']:.3f}  macro-F1 {report['macro_f1']:.3f}  "
-        f"kappa {report['cohen_kappa']:.3f}  template {report['template_compliance']:.3f}  "
-        f"none rejected {report['none_rejection']}  (n={report['n_commands']} + "
-        f"{report['n_none']} none; fallbacks {report['fallbacks']})"
+        f"accuracy {_fmt(report['accuracy'])}  macro-F1 {_fmt(report['macro_f1'])}  "
+        f"kappa {_fmt(report['cohen_kappa'])}  template {_fmt(report['template_compliance'])}  "
+        f"none rejected {_fmt(report['none_rejection'])} (read as STOP "
+        f"{report['none_read_as_stop']})  (n={report['n_commands']} + {report['n_none']} "
+        f"none; fallbacks {report['fallbacks']})",
+        highlight=False,
     )
     replies = report["replies"]
     console.print(
@@ -111,6 +128,49 @@ def intents_command(
                 *(_fmt(r[k]) for k in ("accuracy", "none_rejection", "stop_recall")),
             )
         console.print(sweep)
+
+
+def everyday_command(
+    data: Annotated[
+        Path | None,
+        typer.Option(
+            "--data", help="CSV (or .csv.gz) with a text column.", show_default=SHIPPED_EVERYDAY
+        ),
+    ] = None,
+    backend: Annotated[str | None, typer.Option("--backend", help=BACKEND_HELP)] = None,
+    out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] = None,
+    config: Annotated[Path | None, typer.Option("--config", help=CONFIG_HELP)] = None,
+    model: Annotated[str | None, typer.Option("--model", help=MODEL_HELP)] = None,
+) -> None:
+    """LLM-1 on everyday lines that ask for nothing: the share left without a command and
+    the commands given (the external check)."""
+    from explaindrive.language.data import EVERYDAY_CHECK, data_path
+    from explaindrive.language.intent.corpus import read_lines
+
+    refuse_bad_outputs(files=((out, "--json"),))
+    data = data or data_path(EVERYDAY_CHECK)
+    try:
+        texts = [row["text"] for row in read_lines(data)]
+        if not texts:
+            raise ValueError(f"{data}: no rows")
+        from explaindrive.language.stack import make_language_stack
+
+        stack = make_language_stack(backend, load_config(config, model)).load()
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+    from explaindrive.language.evaluation import evaluate_everyday
+
+    report = evaluate_everyday(stack.interpreter, texts)
+    report.update(backend=stack.backend, data=str(data))
+    c = report["commands"]
+    console.print(
+        f"LLM-1 on {data.name} ({stack.backend}): {report['n']} lines, "
+        f"{report['left_without_command']:.4f} left without a command; given fast "
+        f"{c['fast']}, comfort {c['comfort']}, STOP {c['stop']}",
+        highlight=False,
+    )
+    for g in report["given"][:20]:
+        console.print(f"  {g['command']:7s} {g['text'][:90]}", highlight=False)
     _write(out, report)
 
 
@@ -158,7 +218,9 @@ def decisions_command(
 
 
 def register(app: typer.Typer) -> None:
-    """Mount the ``score`` group, with ``intents`` and ``decisions``, on the root command."""
+    """Mount the ``score`` group (``intents``, ``everyday``, ``decisions``) on the root
+    command."""
     score_app.command("intents")(intents_command)
+    score_app.command("everyday")(everyday_command)
     score_app.command("decisions")(decisions_command)
     app.add_typer(score_app, name="score")

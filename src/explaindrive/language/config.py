@@ -39,18 +39,23 @@ class SpeechConfig(LaxModel):
 
 
 class EmbeddedConfig(LaxModel):
-    """Offline backend: sentence embeddings + shipped classifier, rule engine, templates."""
+    """Offline backend: the fine-tuned intent model, rule engine, templates."""
 
     embedding_model_dir: Path | None = None
-    """sentence-transformers model directory; ``None`` = all-MiniLM-L6-v2 as packaged."""
-    classifier_path: Path | None = None
-    """``.npz`` classifier weights; ``None`` = the weights shipped in ``language/data``."""
+    """The sentence-transformers model the intent model's adapters apply to; ``None`` =
+    all-MiniLM-L6-v2 as packaged (its weights must be the ones the model was trained on)."""
+    model_path: Path | None = None
+    """``.npz`` intent model (adapters, head, thresholds); ``None`` = the shipped one."""
+    command_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
+    """A fast or comfort reading needs at least this probability, else the line is left
+    without a command; ``None`` = the value stored with the model (chosen on its
+    calibration pool)."""
     stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
-    """STOP wins whenever its probability reaches this; ``None`` = the value stored with the
-    weights (tuned on the held-out development splits)."""
-    none_margin: float | None = Field(default=None, ge=0.0, le=1.0)
-    """A request is off-topic only when its off-topic probability exceeds the best command's
-    by more than this; ``None`` = the value stored with the weights."""
+    """A STOP reading needs at least this probability; ``None`` = the value stored with the
+    model."""
+    stop_path: bool = True
+    """Read STOP's explicit phrases (``pull over``, ``let me out``...) as STOP unless the
+    model is sure of another reading (:mod:`explaindrive.language.intent.stop_path`)."""
     encoder_runtime: EncoderRuntime = DEFAULT_RUNTIME
     """``onnx`` (ONNX Runtime on an export cached on first use; about twice as fast)
     or ``torch``; the embeddings agree to float rounding, so the same weights serve both."""

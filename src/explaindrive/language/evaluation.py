@@ -22,7 +22,11 @@ from explaindrive.language.explanation.hazards import Factor
 from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.language.intent.agreement import TwoReadings, trust_sweep
 from explaindrive.language.intent.datasets import CommandExample
-from explaindrive.language.intent.interpreter import IntentInterpreter, is_template_compliant
+from explaindrive.language.intent.interpreter import (
+    IntentInterpreter,
+    IntentResult,
+    is_template_compliant,
+)
 
 CONFUSION_LABELS: tuple[str, ...] = (*COMMAND_LABELS, "none")
 
@@ -45,27 +49,46 @@ def intent_metrics(
     The 3-class figures (accuracy, macro-F1, kappa, per class) use the rows whose true
     label is a command; a ``none`` prediction on such a row counts as an error. Template
     compliance is the share of those rows whose output is exactly the template question.
-    ``none_rejection`` is the share of ``none`` rows left without a command.
+    ``none_rejection`` is the share of ``none`` rows left without a command. A file
+    without command rows (or without ``none`` rows) gets ``None`` for the figures it
+    cannot give.
     """
     idx = [i for i, t in enumerate(truth) if t != "none"]
-    t3 = [truth[i] for i in idx]
-    p3 = [pred[i] for i in idx]
-    labels = list(COMMAND_LABELS)
-    prec, rec, f1, sup = precision_recall_fscore_support(t3, p3, labels=labels, zero_division=0)
     none_idx = [i for i, t in enumerate(truth) if t == "none"]
-    return {
+    out: dict[str, Any] = {
         "n": len(truth),
         "n_commands": len(idx),
+        "n_none": len(none_idx),
+        "none_rejection": round(float(np.mean([pred[i] == "none" for i in none_idx])), 4)
+        if none_idx
+        else None,
+        "none_read_as_stop": sum(pred[i] == "stop" for i in none_idx),
+        "confusion": {
+            "labels": list(CONFUSION_LABELS),
+            "matrix": confusion_matrix(truth, pred, labels=list(CONFUSION_LABELS)).tolist(),
+        },
+    }
+    out.update(_command_metrics([truth[i] for i in idx], [pred[i] for i in idx]))
+    out["template_compliance"] = (
+        round(float(np.mean([is_template_compliant(confirmations[i]) for i in idx])), 4)
+        if idx
+        else None
+    )
+    return out
+
+
+def _command_metrics(t3: list[str], p3: list[str]) -> dict[str, Any]:
+    """Accuracy, macro-F1, kappa and per-class figures over the command rows."""
+    labels = list(COMMAND_LABELS)
+    if not t3:
+        return {"accuracy": None, "macro_f1": None, "cohen_kappa": None, "per_class": {}}
+    prec, rec, f1, sup = precision_recall_fscore_support(t3, p3, labels=labels, zero_division=0)
+    return {
         "accuracy": round(float(accuracy_score(t3, p3)), 4),
         "macro_f1": round(
             float(f1_score(t3, p3, labels=labels, average="macro", zero_division=0)), 4
         ),
-        "cohen_kappa": round(float(cohen_kappa_score(t3, p3)), 4),
-        "template_compliance": round(
-            float(np.mean([is_template_compliant(confirmations[i]) for i in idx])), 4
-        )
-        if idx
-        else 0.0,
+        "cohen_kappa": round(float(cohen_kappa_score(t3, p3)), 4) if len(set(t3)) > 1 else None,
         "per_class": {
             name: {
                 "precision": round(float(prec[k]), 4),
@@ -75,14 +98,6 @@ def intent_metrics(
             }
             for k, name in enumerate(labels)
         },
-        "confusion": {
-            "labels": list(CONFUSION_LABELS),
-            "matrix": confusion_matrix(truth, pred, labels=list(CONFUSION_LABELS)).tolist(),
-        },
-        "none_rejection": round(float(np.mean([pred[i] == "none" for i in none_idx])), 4)
-        if none_idx
-        else None,
-        "n_none": len(none_idx),
     }
 
 
@@ -98,23 +113,36 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
     :data:`~explaindrive.language.intent.agreement.TRUST_GRID` would have given on the same
     replies (:func:`~explaindrive.language.intent.agreement.trust_sweep`).
     """
-    preds: list[str] = []
-    confs: list[str | None] = []
-    latencies: list[float] = []
+    results = [interpreter.interpret(row.text) for row in rows]
+    preds = [r.intent.label if r.intent is not None else "none" for r in results]
+    both = [
+        TwoReadings(row.label, r.readings[0], r.readings[1], r.readings[2], True)
+        if r.readings is not None
+        # the embedded reading stood alone (a fallback, the STOP lane, no remote)
+        else TwoReadings(row.label, r.intent, 1.0, None, False)
+        for row, r in zip(rows, results, strict=True)
+    ]
+    replies = _reply_counts(results)
+    out = intent_metrics([r.label for r in rows], preds, [r.confirmation for r in results])
+    out.update(
+        errors=_errors(rows, results, preds),
+        fallbacks=replies["fallback"],
+        replies=replies,
+        by_kind=_by_kind(rows, preds),
+        negated_stops_read_as_stop=sum(
+            p == "stop" for p, row in zip(preds, rows, strict=True) if row.kind == "negated_stop"
+        ),
+        latency=_percentiles([r.latency_s for r in results]),
+    )
+    if any(x.readable for x in both):
+        out["trust_sweep"] = trust_sweep(both)
+    return out
+
+
+def _reply_counts(results: list[IntentResult]) -> dict[str, int]:
+    """What became of a remote model's replies (see :func:`evaluate_intents`)."""
     replies = {"accepted": 0, "fallback": 0, "vetoed": 0, "not_asked": 0}
-    by_kind: dict[str, list[int]] = {}
-    errors = []
-    both: list[TwoReadings] = []
-    for row in rows:
-        r = interpreter.interpret(row.text)
-        label = r.intent.label if r.intent is not None else "none"
-        if r.readings is not None:
-            both.append(TwoReadings(row.label, r.readings[0], r.readings[1], r.readings[2], True))
-        else:  # the embedded reading stood alone (a fallback, the STOP lane, no remote)
-            both.append(TwoReadings(row.label, r.intent, 1.0, None, False))
-        preds.append(label)
-        confs.append(r.confirmation)
-        latencies.append(r.latency_s)
+    for r in results:
         if r.fallback:
             replies["fallback"] += 1
         elif r.overruled:
@@ -123,33 +151,65 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
             replies["accepted"] += 1
         else:
             replies["not_asked"] += 1
+    return replies
+
+
+def _by_kind(rows: list[CommandExample], preds: list[str]) -> dict[str, list[int]]:
+    """[correct, total] per kind of request (``-`` for rows without one)."""
+    by_kind: dict[str, list[int]] = {}
+    for row, label in zip(rows, preds, strict=True):
         tally = by_kind.setdefault(row.kind or "-", [0, 0])
         tally[0] += label == row.label
         tally[1] += 1
-        if label != row.label:
-            error: dict[str, str | None] = {
-                "text": row.text,
-                "label": row.label,
-                "pred": label,
-                "kind": row.kind,
-            }
-            if r.raw_reply is not None:
-                error.update(rule=r.rule, raw_reply=r.raw_reply)
-            errors.append(error)
-    out = intent_metrics([r.label for r in rows], preds, confs)
-    out.update(
-        errors=errors,
-        fallbacks=replies["fallback"],
-        replies=replies,
-        by_kind=by_kind,
-        negated_stops_read_as_stop=sum(
-            p == "stop" for p, row in zip(preds, rows, strict=True) if row.kind == "negated_stop"
-        ),
-        latency=_percentiles(latencies),
-    )
-    if any(x.readable for x in both):
-        out["trust_sweep"] = trust_sweep(both)
-    return out
+    return by_kind
+
+
+def _errors(
+    rows: list[CommandExample], results: list[IntentResult], preds: list[str]
+) -> list[dict[str, str | None]]:
+    """Every row read wrong, with the remote reply where there was one."""
+    errors = []
+    for row, r, label in zip(rows, results, preds, strict=True):
+        if label == row.label:
+            continue
+        error: dict[str, str | None] = {
+            "text": row.text,
+            "label": row.label,
+            "pred": label,
+            "kind": row.kind,
+            "reading": r.reading,
+        }
+        if r.raw_reply is not None:
+            error.update(rule=r.rule, raw_reply=r.raw_reply)
+        errors.append(error)
+    return errors
+
+
+def evaluate_everyday(interpreter: IntentInterpreter, texts: list[str]) -> dict[str, Any]:
+    """LLM-1 on everyday lines that ask for no command (the external check).
+
+    Returns:
+        ``n``; ``left_without_command`` (share); ``commands`` (count per command given);
+        ``readings`` (count per reading); ``given`` (every line given a command, with it).
+    """
+    results = [interpreter.interpret(t) for t in texts]
+    commands = {c: 0 for c in COMMAND_LABELS}
+    readings: dict[str, int] = {}
+    given = []
+    for text, r in zip(texts, results, strict=True):
+        readings[r.reading or "-"] = readings.get(r.reading or "-", 0) + 1
+        if r.intent is not None:
+            commands[r.intent.label] += 1
+            given.append({"text": text, "command": r.intent.label})
+    n = len(texts)
+    return {
+        "n": n,
+        "left_without_command": round(1.0 - len(given) / n, 4) if n else None,
+        "commands": commands,
+        "readings": readings,
+        "given": given,
+        "latency": _percentiles([r.latency_s for r in results]),
+    }
 
 
 def evaluate_decisions(

@@ -68,6 +68,7 @@ class RideCounts:
     """Counters for the ride summary."""
 
     requests: int = 0
+    answers: int = 0
     understood: int = 0
     rephrase: int = 0
     confirmations: int = 0

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from explaindrive.commands import Command
+from explaindrive.language.intent.model import ANSWERS
 from explaindrive.language.speech.transcriber import AudioError
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
@@ -69,6 +70,7 @@ class PassengerRequests:
         self.pending_confirmation: PassengerRequest | None = None
         self._requests = 0
         self._newest_read = 0  # the latest request understood as a command
+        self._held_answer: bool | None = None  # a yes/no heard before its question
 
     def submit(self, line: PassengerInput, confirm: bool | None = None) -> int:
         """Queue a line for interpretation; returns its request id.
@@ -139,6 +141,39 @@ class PassengerRequests:
         """
         req = job.request
         result = heard.result
+        self._note_heard(req, heard, latency_s)
+        if result is None:
+            return
+        if result.reading in ANSWERS:
+            self._hear_answer(result.reading == "yes")
+            return
+        if result.intent is None:
+            self.counts.rephrase += 1
+            return
+        if req.id < self._newest_read:
+            # a later request was understood first: the passenger's last instruction counts
+            self.counts.superseded += 1
+            self._note({"type": EventType.SUPERSEDED, "id": req.id, "by": self._newest_read})
+            return
+        self.counts.understood += 1
+        self._newest_read = req.id
+        req.intent, req.question = result.intent, result.confirmation
+        if result.intent is Command.STOP and self.config.stop_without_confirm:
+            self._resolve(req, True, source="stop-without-confirm")
+        elif req.confirm is not None:
+            self._resolve(req, req.confirm, source="script")
+        elif self.config.auto_confirm:
+            self._resolve(req, True, source="auto")
+        else:
+            if self.pending_confirmation is not None:
+                self._note({"type": EventType.SUPERSEDED, "id": self.pending_confirmation.id})
+            self.pending_confirmation = req
+            if self._held_answer is not None:
+                yes, self._held_answer = self._held_answer, None
+                self.answer(yes)
+
+    def _note_heard(self, req: PassengerRequest, heard: Interpretation, latency_s: float) -> None:
+        """Log the transcript of a spoken line, and the interpretation or why there is none."""
         if isinstance(req.line, SpokenLine):
             self._note(
                 {
@@ -148,6 +183,7 @@ class PassengerRequests:
                     "latency_s": round(heard.transcribe_s, 4),
                 }
             )
+        result = heard.result
         if result is None:
             self.counts.rephrase += 1
             self._note(
@@ -170,27 +206,19 @@ class PassengerRequests:
                 "raw_reply": result.raw_reply,  # for the log; the page drops it
             }
         )
-        if result.intent is None:
-            self.counts.rephrase += 1
-            return
-        if req.id < self._newest_read:
-            # a later request was understood first: the passenger's last instruction counts
-            self.counts.superseded += 1
-            self._note({"type": EventType.SUPERSEDED, "id": req.id, "by": self._newest_read})
-            return
-        self.counts.understood += 1
-        self._newest_read = req.id
-        req.intent, req.question = result.intent, result.confirmation
-        if result.intent is Command.STOP and self.config.stop_without_confirm:
-            self._resolve(req, True, source="stop-without-confirm")
-        elif req.confirm is not None:
-            self._resolve(req, req.confirm, source="script")
-        elif self.config.auto_confirm:
-            self._resolve(req, True, source="auto")
+
+    def _hear_answer(self, yes: bool) -> None:
+        """A line read as yes or no answers the pending question; heard while a request is
+        still being interpreted (several workers: the answer may be read first), it waits
+        for that request's question."""
+        self.counts.requests -= 1  # the line was an answer, not a request
+        self.counts.answers += 1
+        if self.pending_confirmation is not None:
+            self.answer(yes)
+        elif self.lane.pending_kind(TaskKind.INTERPRET):
+            self._held_answer = yes
         else:
-            if self.pending_confirmation is not None:
-                self._note({"type": EventType.SUPERSEDED, "id": self.pending_confirmation.id})
-            self.pending_confirmation = req
+            self.answer(yes)  # noted as ignored: no question pending
 
     def _resolve(self, req: PassengerRequest, yes: bool, source: str) -> None:
         if self.pending_confirmation is req:

@@ -29,9 +29,8 @@ from pathlib import Path
 from typing import IO, Any
 
 from explaindrive.jsonsafe import finite
-from explaindrive.language.intent.interpreter import parse_confirmation_answer
 from explaindrive.redact import redact, redact_json
-from explaindrive.ride.inputs import PassengerInput, SpokenLine, TypedLine
+from explaindrive.ride.inputs import PassengerInput, TypedLine
 from explaindrive.ride.plot import plot_ride
 from explaindrive.ride.records import StepRecord
 from explaindrive.ride.script import ScriptLine
@@ -244,13 +243,12 @@ def _drive(
     stop: threading.Event | None,
 ) -> None:
     """The ride loop: due lines, typed input, one step, the event log, the pace."""
-    held: list[PassengerInput] = []  # typed answers waiting for their question
     while not session.done and not (stop is not None and stop.is_set()):
         tick = time.monotonic()
         while todo and todo[0].t <= session.t:
             line = todo.popleft()
             session.hear(line.line, confirm=line.answer)
-        _drain_typed(session, typed, held)
+        _drain_typed(session, typed)
         rec = session.step()
         if on_step is not None:
             on_step(rec)
@@ -290,36 +288,17 @@ def _finish(
     os.replace(summary_tmp, outputs.summary)
 
 
-def _drain_typed(
-    session: RideSession,
-    typed: queue.Queue[PassengerInput | str] | None,
-    held: list[PassengerInput] | None = None,
-) -> None:
-    """Hand the passenger's lines to the session; a yes/no typed while a request is still
-    being interpreted waits (in ``held``) for its question instead of becoming a new request."""
+def _drain_typed(session: RideSession, typed: queue.Queue[PassengerInput | str] | None) -> None:
+    """Hand the passenger's lines to the session: requests, and yes/no answers, which LLM-1
+    reads as such (:meth:`~explaindrive.ride.requests.PassengerRequests.on_interpretation`)."""
     if typed is None:
         return
-    lines = list(held or [])
-    if held is not None:
-        held.clear()
     while True:
         try:
             item = typed.get_nowait()
         except queue.Empty:
             break
-        lines.append(TypedLine(item) if isinstance(item, str) else item)
-    for line in lines:
-        match line:
-            case SpokenLine():
-                session.hear(line)
-            case TypedLine(raw):
-                text = raw.strip()
-                if not text:
-                    continue
-                answer = parse_confirmation_answer(text)
-                if answer is not None and session.pending_confirmation is not None:
-                    session.answer(answer)
-                elif answer is not None and session.interpreting and held is not None:
-                    held.append(line)
-                else:
-                    session.say(text)
+        line = TypedLine(item) if isinstance(item, str) else item
+        if isinstance(line, TypedLine) and not line.text.strip():
+            continue
+        session.hear(line)

@@ -160,7 +160,7 @@ def test_loading_the_openai_stack_loads_the_offline_fallback() -> None:
 
     stack = make_language_stack("openai", LanguageConfig())
     assert isinstance(stack.interpreter, OpenAIIntentInterpreter)
-    encoder = stack.interpreter.fallback.encoder
-    assert encoder._onnx is None  # lazy until loaded
+    reader = stack.interpreter.fallback.reader
+    assert not reader.loaded  # lazy until loaded
     stack.load()  # a ride calls this before it starts
-    assert encoder._onnx is not None
+    assert reader.loaded

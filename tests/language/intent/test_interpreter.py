@@ -9,7 +9,6 @@ from explaindrive.language.intent.interpreter import (
     REPHRASE_MESSAGE,
     format_confirmation,
     parse_confirmation,
-    parse_confirmation_answer,
 )
 
 
@@ -35,11 +34,11 @@ def test_template_round_trip() -> None:
         ("nope, cancel", False),
         ("maybe later", None),
         ("yes... no", None),
-        ("Yes, stop", True),
+        ("Yes, stop", None),  # a new request (STOP), not an answer
     ],
 )
-def test_confirmation_answers(answer: str, expected: bool | None) -> None:
-    assert parse_confirmation_answer(answer) is expected
+def test_confirmation_answers(interpreter, answer: str, expected: bool | None) -> None:  # type: ignore[no-untyped-def]
+    assert interpreter.read_answer(answer) is expected
 
 
 @pytest.mark.parametrize(

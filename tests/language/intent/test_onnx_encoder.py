@@ -11,13 +11,11 @@ import pytest
 from pydantic import ValidationError
 
 from explaindrive.cache import cache_dir
-from explaindrive.language.backends.embedded import EmbeddedIntentInterpreter
 from explaindrive.language.config import EmbeddedConfig
 from explaindrive.language.data import TRAIN_CSV, data_path
 from explaindrive.language.intent import onnx_encoder
 from explaindrive.language.intent.datasets import load_commands
-from explaindrive.language.intent.encoders import check_runtime, minilm_model_dir
-from explaindrive.language.intent.features import SentenceEncoder, normalize_text
+from explaindrive.language.intent.encoders import SentenceEncoder, check_runtime, minilm_model_dir
 from explaindrive.language.intent.onnx_encoder import export_dir, export_onnx, onnx_model_file
 
 LONG = " ".join(["please slow down a little because the road is wet"] * 40)  # > 256 tokens
@@ -35,20 +33,19 @@ def test_runtime_names() -> None:
     assert SentenceEncoder(runtime="torch", threads=2).threads == 2
 
 
-def test_onnx_matches_torch_on_requests_and_overlong_text(
-    interpreter: EmbeddedIntentInterpreter,
-) -> None:
-    assert interpreter.encoder.runtime == "onnx"
+def test_onnx_matches_torch_on_requests_and_overlong_text() -> None:
+    onnx_encoder = SentenceEncoder()
+    assert onnx_encoder.runtime == "onnx"
     rows = [r for r in load_commands(data_path(TRAIN_CSV)) if r.split == "dev-1"][:40]
-    texts = [normalize_text(r.text) for r in rows]
+    texts = [r.text for r in rows]
     texts += ["", LONG]
     torch_encoder = SentenceEncoder(runtime="torch")
-    onnx_emb = interpreter.encoder.encode(texts)
+    onnx_emb = onnx_encoder.encode(texts)
     assert float(np.max(np.abs(onnx_emb - torch_encoder.encode(texts)))) < 1e-5
     # one sentence at a time, as in a ride, gives the batch's embeddings
-    single = np.vstack([interpreter.encoder.encode([t]) for t in texts[:5]])
+    single = np.vstack([onnx_encoder.encode([t]) for t in texts[:5]])
     assert float(np.max(np.abs(single - onnx_emb[:5]))) < 1e-5
-    runner = interpreter.encoder._onnx
+    runner = onnx_encoder._onnx
     assert runner is not None
     prepare = torch_encoder._model.preprocess
     for text in (texts[0], LONG):
@@ -57,9 +54,8 @@ def test_onnx_matches_torch_on_requests_and_overlong_text(
     assert len(runner.tokens([LONG])["input_ids"][0]) == 256  # truncated like torch
 
 
-def test_export_is_kept_and_reused(
-    interpreter: EmbeddedIntentInterpreter, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_export_is_kept_and_reused(monkeypatch: pytest.MonkeyPatch) -> None:
+    SentenceEncoder().load()  # exported on first use (or already in the cache)
     target = export_dir(minilm_model_dir(), cache_dir(), "minilm")
     assert (target / onnx_encoder.ONNX_FILE).is_file()
     assert "max |onnx - torch|" in (target / ".complete").read_text()

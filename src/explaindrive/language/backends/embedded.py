@@ -1,4 +1,4 @@
-"""The offline, deterministic backend: embedding classifier, rule engine, templates."""
+"""The offline, deterministic backend: the fine-tuned intent model, rule engine, templates."""
 
 from __future__ import annotations
 
@@ -20,84 +20,87 @@ from explaindrive.language.explanation.explainer import (
     template_explanation,
 )
 from explaindrive.language.explanation.summary import StateRecord
-from explaindrive.language.intent.classifier import IntentClassifier
-from explaindrive.language.intent.corrections import last_instruction
-from explaindrive.language.intent.datasets import INTENT_LABELS
-from explaindrive.language.intent.features import SentenceEncoder, features
 from explaindrive.language.intent.interpreter import (
     REPHRASE_MESSAGE,
     IntentInterpreter,
     IntentResult,
     format_confirmation,
 )
-from explaindrive.language.intent.negation import stop_is_ruled_out
+from explaindrive.language.intent.model import Reading
+from explaindrive.language.intent.reader import LineReader
 
 log = logging.getLogger(__name__)
 
 NAME = "embedded"
-_STOP = INTENT_LABELS.index("stop")
 
 
 class EmbeddedIntentInterpreter(IntentInterpreter):
-    """LLM-1 offline: sentence-encoder features + the shipped classifier."""
+    """LLM-1 offline: the fine-tuned sentence encoder and its reading head
+    (:mod:`explaindrive.language.intent.model`)."""
 
     name = NAME
 
-    def __init__(
-        self, config: EmbeddedConfig | None = None, encoder: SentenceEncoder | None = None
-    ) -> None:
-        """Args: config: backend options; encoder: share one loaded encoder between users."""
+    def __init__(self, config: EmbeddedConfig | None = None) -> None:
+        """Args: config: backend options (the model, its thresholds, the encoder runtime).
+
+        Raises:
+            FileNotFoundError, ValueError: for a missing or invalid model file.
+        """
         self.config = config or EmbeddedConfig()
-        self.encoder = encoder or SentenceEncoder(
+        self.reader = LineReader(
+            self.config.model_path,
             self.config.embedding_model_dir,
             self.config.encoder_threads,
             self.config.encoder_runtime,
+            self.config.command_threshold,
+            self.config.stop_threshold,
+            self.config.stop_path,
         )
-        self.classifier = IntentClassifier.load(self.config.classifier_path)
 
     def load(self) -> None:
-        """Load the sentence encoder now rather than on the first request."""
-        self.encoder.load()
+        """Build and load the fine-tuned encoder now rather than on the first request."""
+        self.reader.load()
 
     def interpret(self, text: str) -> IntentResult:
-        """Classify ``text``; an empty or off-topic request gets a request to rephrase.
+        """Read ``text``; a line that asks for no command gets a request to rephrase.
 
-        A request that corrects itself is read by its last instruction: the part after
-        its last repair marker (:func:`~explaindrive.language.intent.corrections.last_instruction`)
-        decides whenever it asks for a command on its own. A line that mentions stopping
-        only negated or in a complaint
-        (:func:`~explaindrive.language.intent.negation.stop_is_ruled_out`) is not read as STOP.
+        The result's ``reading`` says what the line is when it is not a command: ``why``
+        (a question about the car's behaviour), ``yes`` / ``no`` (an answer), ``none``.
         """
         t0 = time.perf_counter()
         if not text or not text.strip():
-            return IntentResult(None, REPHRASE_MESSAGE, NAME, False, time.perf_counter() - t0, {})
-        last = last_instruction(text)
-        texts = [text] if last is None else [text, last]
-        p = self.classifier.proba(features(self.encoder, texts, self.classifier.spec))
-        for i, t in enumerate(texts):  # "don't stop here", "another red light": not STOP
-            if stop_is_ruled_out(t):
-                p[i, _STOP] = 0.0
-                p[i] /= max(float(p[i].sum()), 1e-12)
-        labels = [
-            self.classifier.decide(row, self.config.stop_threshold, self.config.none_margin)
-            for row in p
-        ]
-        row = 1 if last is not None and labels[1] != "none" else 0
-        label = labels[row]
-        scores = {name: round(float(v), 4) for name, v in zip(INTENT_LABELS, p[row], strict=True)}
-        intent = None if label == "none" else Command.parse(label)
+            return IntentResult(
+                None, REPHRASE_MESSAGE, NAME, False, time.perf_counter() - t0, {}, reading="none"
+            )
+        (reading,) = self.reader.read([text])
+        intent = Command.parse(reading.command) if reading.command is not None else None
         confirmation = format_confirmation(intent) if intent is not None else REPHRASE_MESSAGE
-        latency = time.perf_counter() - t0
-        log.debug("embedded intent %s for %r (%s)", label, text, scores)
+        log.debug("embedded reading %s for %r (%s)", reading.reading, text, reading.scores())
         return IntentResult(
             intent,
             confirmation,
             NAME,
             False,
-            latency,
-            scores,
-            instruction=texts[row] if row == 1 else None,
+            time.perf_counter() - t0,
+            command_scores(reading),
+            reading=reading.reading,
         )
+
+    def read_answer(self, text: str) -> bool | None:
+        """The passenger's answer to a confirmation question: ``True`` for yes, ``False``
+        for no, ``None`` when the line is neither (a new request, say)."""
+        if not text or not text.strip():
+            return None
+        (reading,) = self.reader.read([text])
+        return {"yes": True, "no": False}.get(reading.reading)
+
+
+def command_scores(reading: Reading) -> dict[str, float]:
+    """The probabilities of the three commands and of ``none``, every reading that asks for
+    no command taken together (what the agreement with a remote model weighs)."""
+    scores = {c.label: float(reading.p[c]) for c in Command}
+    scores["none"] = max(0.0, 1.0 - sum(scores.values()))
+    return {k: round(v, 4) for k, v in scores.items()}
 
 
 class RuleDecider(ExplanationDecider):

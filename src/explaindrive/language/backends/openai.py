@@ -18,7 +18,7 @@ import os
 import time
 from typing import Any, TypeVar
 
-from explaindrive.commands import Command
+from explaindrive.commands import COMMAND_LABELS, Command
 from explaindrive.language.backends import deadline
 from explaindrive.language.backends.deadline import DeadlineExceededError
 from explaindrive.language.backends.embedded import (
@@ -56,6 +56,7 @@ from explaindrive.language.intent.interpreter import (
     IntentResult,
     format_confirmation,
 )
+from explaindrive.language.intent.model import ANSWERS
 from explaindrive.redact import redact
 
 log = logging.getLogger(__name__)
@@ -214,7 +215,8 @@ class OpenAIIntentInterpreter(IntentInterpreter):
 
         The embedded interpreter reads every request first (tens of milliseconds). A STOP
         found there is returned at once (``stop_lane=True``) without asking the endpoint,
-        so a STOP never waits on a remote model. Otherwise the endpoint's reply is read
+        so a STOP never waits on a remote model; nor is a yes or no to a confirmation
+        question (``reading`` ``yes`` / ``no``) sent. Otherwise the endpoint's reply is read
         (:func:`~explaindrive.language.backends.replies.read_confirmation`) and the two readings
         are reconciled (:func:`~explaindrive.language.intent.agreement.reconcile`). On any
         failure, the deadline and an unreadable reply included, the embedded reading
@@ -223,7 +225,7 @@ class OpenAIIntentInterpreter(IntentInterpreter):
         """
         t0 = time.perf_counter()
         local = self.fallback.interpret(text)
-        if local.intent is Command.STOP or not text.strip():
+        if local.intent is Command.STOP or local.reading in ANSWERS or not text.strip():
             stop = local.intent is Command.STOP
             return dataclasses.replace(
                 local,
@@ -260,12 +262,20 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             False,
             time.perf_counter() - t0,
             local.scores,
-            instruction=local.instruction if own else None,
             rule=verdict.rule,
             overruled=own,
             raw_reply=raw,
             readings=(local.intent, local_p, reading.command),
+            reading=_reading(verdict.intent, local.reading),
         )
+
+
+def _reading(intent: Command | None, local: str | None) -> str | None:
+    """The line's reading once the command is settled: the command's label, else the
+    embedded reading when it was no command (``why``, an answer), else ``none``."""
+    if intent is not None:
+        return intent.label
+    return local if local not in COMMAND_LABELS else "none"
 
 
 class OpenAIDecider(ExplanationDecider):

@@ -1,8 +1,9 @@
 """The data shipped with the language layer, and where it is installed.
 
-The command files are read by :mod:`explaindrive.language.intent.datasets`, the decision
-file by :mod:`explaindrive.language.explanation.datasets`; the classifier weights are
-LLM-1's (:mod:`explaindrive.language.intent.classifier`).
+The command files are read by :mod:`explaindrive.language.intent.datasets` (scoring) and
+:mod:`explaindrive.language.intent.corpus` (fine-tuning), the decision file by
+:mod:`explaindrive.language.explanation.datasets`; the intent model is LLM-1's
+(:mod:`explaindrive.language.intent.model`).
 """
 
 from __future__ import annotations
@@ -11,18 +12,30 @@ from importlib import resources
 from pathlib import Path
 
 TRAIN_CSV = "commands_train.csv"
-"""Every labelled request a model may be built or selected on; the split column says how."""
+"""Labelled passenger requests LLM-1 is fine-tuned on; its ``reserve`` split is kept for the
+calibration of the thresholds."""
+WRITTEN_CSV = "commands_written.csv"
+"""In-car chatter and phone talk with pace and stopping words in other senses, questions
+about the car's behaviour, answers to a confirmation and negated requests, written for
+LLM-1's training; one line in seven is kept for calibration."""
+EVERYDAY_TRAIN = "everyday_train.csv.gz"
+"""Everyday language from corpora public packages ship (``scripts/build_everyday_corpus.py``):
+LLM-1's negatives (split ``train``) and part of its calibration pool (``calibration``)."""
+EVERYDAY_CHECK = "everyday_check.csv.gz"
+"""The external check: chat messages of a public dialogue corpus no model is trained or
+selected on."""
+HELDOUT_CSV = "commands_heldout.csv"
+"""The test split: written and committed before any model was run on it, scored once."""
 TEST_CSV = "commands_test.csv"
-"""The blind test requests, never used to build or select a model."""
+"""A development split (scored as a test split once, read since): calibration only."""
 BLIND_CSV = "commands_blind.csv"
-"""A second blind test split, written for the readings the first one missed: negated stops,
-complaints that mention lights, stops or arriving, self-corrections, hedges, typos and
-speech-recognition errors, polite, terse and rude phrasings, and off-topic remarks that
-use driving words. Never used to build or select a model."""
+"""A development split of negated stops, complaints, self-corrections, hedges, typos,
+speech-recognition errors and off-topic remarks with driving words (scored as a test split
+once, read since): calibration only."""
 DECISIONS_JSONL = "decisions.jsonl"
 """Labelled state records for the LLM-2 trigger and the LLM-3 explanations."""
-CLASSIFIER_NPZ = "intent_classifier.npz"
-"""The shipped LLM-1 weights over all-MiniLM-L6-v2."""
+INTENT_MODEL = "intent_model.npz"
+"""The shipped LLM-1: adapters of all-MiniLM-L6-v2, reading head and thresholds."""
 
 
 def data_path(name: str) -> Path:

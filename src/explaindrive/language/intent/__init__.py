@@ -1,17 +1,18 @@
-"""LLM-1: a passenger's request to a command (fast, comfort, stop) and its confirmation.
+"""LLM-1: a passenger's line to a command (fast, comfort, stop), or to what else it is.
 
 - :mod:`~explaindrive.language.intent.interpreter`: the interpreter's interface, its
-  results, the confirmation template and yes/no answers;
-- the embedded classifier: :mod:`~explaindrive.language.intent.classifier` at run time,
-  built by :mod:`~explaindrive.language.intent.training` from the command files
-  (:mod:`~explaindrive.language.intent.datasets`), on sentence features
-  (:mod:`~explaindrive.language.intent.features`) of the sentence encoder
+  results and the confirmation template;
+- the embedded model: all-MiniLM-L6-v2 fine-tuned through low-rank adapters
+  (:mod:`~explaindrive.language.intent.adapter`) with a reading head that may abstain
+  (:mod:`~explaindrive.language.intent.model`), run by
+  :mod:`~explaindrive.language.intent.reader` on the sentence encoder
   (:mod:`~explaindrive.language.intent.encoders`,
-  :mod:`~explaindrive.language.intent.onnx_encoder`) and lexical direction cues
-  (:mod:`~explaindrive.language.intent.cues`,
-  :mod:`~explaindrive.language.intent.cue_lexicon`);
-- readings it corrects: negated stops (:mod:`~explaindrive.language.intent.negation`) and
-  self-corrections (:mod:`~explaindrive.language.intent.corrections`);
+  :mod:`~explaindrive.language.intent.onnx_encoder`), with STOP's explicit path
+  (:mod:`~explaindrive.language.intent.stop_path`);
+- its training: :mod:`~explaindrive.language.intent.finetune` on the pools of
+  :mod:`~explaindrive.language.intent.corpus`, thresholds from
+  :mod:`~explaindrive.language.intent.calibration`; the command files' readers for
+  scoring: :mod:`~explaindrive.language.intent.datasets`;
 - :mod:`~explaindrive.language.intent.agreement`: when a remote model and the embedded
   interpreter read a line differently.
 """

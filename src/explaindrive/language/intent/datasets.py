@@ -6,15 +6,9 @@ indirect, negation, noise, offtopic, correction, tampered). The shipped files ar
 :mod:`explaindrive.language.data`.
 
 The ``split`` column of :data:`~explaindrive.language.data.TRAIN_CSV` says what building
-LLM-1 does with a request:
-
-* ``train``: always fitted on.
-* ``dev-1`` ... ``dev-N``: the development splits. For the choice of hyper-parameters, the
-  STOP threshold and the none margin, each is predicted by a model fitted on ``train`` and
-  the other development splits; the shipped model is then fitted on ``train`` and all of
-  them (:mod:`explaindrive.language.intent.training`).
-* ``reserve``: neither fitted on nor used for choices by the shipped model; free for checks
-  and for a later model's development.
+LLM-1 does with a request: ``train`` and the former development splits ``dev-1`` ...
+``dev-N`` are fine-tuned on; ``reserve`` is kept for the calibration of the thresholds
+(:mod:`explaindrive.language.intent.corpus`).
 """
 
 from __future__ import annotations

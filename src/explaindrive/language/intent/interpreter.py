@@ -41,8 +41,6 @@ class IntentResult:
         latency_s: wall time of the call [s].
         scores: class probabilities when the backend exposes them (embedded), else empty.
         error: why the configured backend was bypassed, when ``fallback`` is ``True``.
-        instruction: when the request corrects itself ("faster... no, stop"), the part
-            after its last repair marker that decided the command; else ``None``.
         stop_lane: ``True`` when the embedded STOP check answered before any remote
             model was asked (a STOP is never left waiting on an endpoint).
         rule: with a remote model, the rule of :mod:`~explaindrive.language.intent.agreement`
@@ -54,6 +52,9 @@ class IntentResult:
         readings: when a remote reply was read, the two readings the agreement policy
             chose between: ``(embedded reading, its probability, remote reading)``, a
             reading ``None`` meaning "not a driving request"; else ``None``.
+        reading: what the embedded model made of the line: a command's label, ``why`` (a
+            question about the car's behaviour), ``yes`` / ``no`` (an answer to a
+            confirmation) or ``none``; ``None`` when no embedded reading was made.
     """
 
     intent: Command | None
@@ -63,12 +64,12 @@ class IntentResult:
     latency_s: float
     scores: dict[str, float]
     error: str | None = None
-    instruction: str | None = None
     stop_lane: bool = False
     rule: str | None = None
     overruled: bool = False
     raw_reply: str | None = None
     readings: tuple[Command | None, float, Command | None] | None = None
+    reading: str | None = None
 
     def to_json(self) -> dict[str, object]:
         """The CLI's JSON shape."""
@@ -77,10 +78,10 @@ class IntentResult:
             "confirmation": self.confirmation,
             "backend": self.backend,
             "fallback": self.fallback,
-            "instruction": self.instruction,
             "stop_lane": self.stop_lane,
             "rule": self.rule,
             "overruled": self.overruled,
+            "reading": self.reading,
         }
 
 
@@ -115,84 +116,3 @@ def parse_confirmation(text: str) -> Command | None:
 def is_template_compliant(text: str | None) -> bool:
     """Whether ``text`` is exactly a template confirmation question."""
     return text is not None and parse_confirmation(text) is not None
-
-
-_YES_PHRASES = (
-    "no problem",
-    "no worries",
-    "why not",
-    "of course",
-    "that's right",
-    "thats right",
-    "that is right",
-    "go ahead",
-    "do it",
-    "sounds good",
-    "please do",
-    "you got it",
-)
-_NO_PHRASES = (
-    "not correct",
-    "not right",
-    "isn't right",
-    "isnt right",
-    "that's wrong",
-    "thats wrong",
-    "don't",
-    "dont",
-    "do not",
-    "never mind",
-    "nevermind",
-    "not what i",
-)
-_YES_WORDS = frozenset(
-    {
-        "yes",
-        "yeah",
-        "yep",
-        "yup",
-        "ya",
-        "correct",
-        "right",
-        "sure",
-        "ok",
-        "okay",
-        "affirmative",
-        "absolutely",
-        "definitely",
-        "indeed",
-        "confirm",
-        "confirmed",
-        "exactly",
-        "perfect",
-        "fine",
-    }
-)
-_NO_WORDS = frozenset({"no", "nope", "nah", "not", "wrong", "incorrect", "cancel", "negative"})
-
-
-def parse_confirmation_answer(text: str) -> bool | None:
-    """Read the passenger's answer to a confirmation question.
-
-    Returns:
-        ``True`` for yes ("yes", "that's right", "sure, no problem"), ``False`` for no
-        ("no", "that's not correct", "cancel"), ``None`` when the answer is neither or
-        contradicts itself ("yes... no").
-    """
-    t = re.sub(r"[^a-z' ]+", " ", text.lower().replace("\u2019", "'"))
-    t = " " + re.sub(r"\s+", " ", t).strip() + " "
-    if any(f" {p} " in t for p in _NO_PHRASES):
-        return False
-    yes = False
-    for phrase in _YES_PHRASES:
-        if f" {phrase} " in t:
-            yes = True
-            t = t.replace(f" {phrase} ", " ")
-    words = set(t.split())
-    yes = yes or bool(words & _YES_WORDS)
-    no = bool(words & _NO_WORDS)
-    if yes and no:
-        return None
-    if no:
-        return False
-    return True if yes else None

@@ -1,0 +1,98 @@
+"""Choosing when LLM-1 answers: the thresholds and the risk-coverage curve.
+
+On the calibration pool (lines the model was not trained on), the STOP threshold is the
+one with the lowest cost, a missed STOP request costing :data:`MISSED_STOP_COST` lines
+read as STOP that asked for none (a false STOP is asked back and can be declined, a
+missed one has to be said again); the command threshold is the lowest that gives at most
+:data:`MAX_FALSE_COMMAND` of the lines that ask for no command a command.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from explaindrive.commands import COMMAND_LABELS
+from explaindrive.language.intent.model import STOP, IntentModel, Thresholds
+
+MISSED_STOP_COST = 5.0
+"""A missed STOP request weighs as much as this many false STOPs."""
+MAX_FALSE_COMMAND = 0.02
+"""Share of lines without a command that may be given one (the target is 0.03)."""
+GRID = np.round(np.arange(0.30, 0.991, 0.01), 2)
+
+
+@dataclass(frozen=True)
+class CurvePoint:
+    """The calibration pool's figures at one command threshold.
+
+    Attributes:
+        threshold: the command threshold.
+        coverage: share of the command requests given a command.
+        risk: share of the lines given a command that were given the wrong one (another
+            command, or one where none was asked).
+        false_command: share of the lines without a command that were given one.
+    """
+
+    threshold: float
+    coverage: float
+    risk: float
+    false_command: float
+
+
+def readings(model: IntentModel, p: NDArray[np.floating], t: Thresholds) -> list[str]:
+    """The reading of each probability row under thresholds ``t``."""
+    return [model.decide(row, t).reading for row in p]
+
+
+def curve(
+    model: IntentModel, p: NDArray[np.floating], labels: list[str], stop: float
+) -> list[CurvePoint]:
+    """The risk-coverage curve over :data:`GRID` at STOP threshold ``stop``."""
+    asked = np.array([lab in COMMAND_LABELS for lab in labels])
+    points = []
+    for t in GRID:
+        got = readings(model, p, Thresholds(float(t), stop))
+        given = np.array([g in COMMAND_LABELS for g in got])
+        wrong = np.array([g != lab for g, lab in zip(got, labels, strict=True)]) & given
+        points.append(
+            CurvePoint(
+                float(t),
+                float(given[asked].mean()) if asked.any() else 0.0,
+                float(wrong.sum() / max(1, given.sum())),
+                float(given[~asked].mean()) if (~asked).any() else 0.0,
+            )
+        )
+    return points
+
+
+def choose_thresholds(
+    model: IntentModel, p: NDArray[np.floating], labels: list[str]
+) -> tuple[Thresholds, str]:
+    """The thresholds (see the module docstring) and a printable report with the curve."""
+    negative = np.array([lab not in COMMAND_LABELS for lab in labels])
+    is_stop = np.array([lab == "stop" for lab in labels])
+    p_stop = np.asarray(p)[:, STOP]
+    costs = [
+        MISSED_STOP_COST * float((p_stop[is_stop] < t).sum()) + float((p_stop[negative] >= t).sum())
+        for t in GRID
+    ]
+    stop = float(GRID[int(np.argmin(costs))])  # the lowest of equal costs
+    points = curve(model, p, labels, stop)
+    command = next(
+        (pt.threshold for pt in points if pt.false_command <= MAX_FALSE_COMMAND),
+        float(GRID[-1]),
+    )
+    lines = [
+        f"calibration pool: {len(labels)} lines, {int(negative.sum())} without a command",
+        f"STOP threshold {stop:.2f}, command threshold {command:.2f}",
+        "threshold  coverage  risk    false-command",
+    ]
+    lines += [
+        f"{pt.threshold:9.2f}  {pt.coverage:8.3f}  {pt.risk:6.3f}  {pt.false_command:6.3f}"
+        for pt in points
+        if round(pt.threshold * 100) % 5 == 0
+    ]
+    return Thresholds(command, stop), "\n".join(lines)

@@ -1,0 +1,122 @@
+"""The lines LLM-1 learns from and is calibrated on, read from ``language/data``.
+
+* Requests (``commands_train.csv``): labelled passenger requests; its ``reserve`` split is
+  kept for calibration.
+* Written lines (``commands_written.csv``): in-car chatter and phone talk that use pace and
+  stopping words in other senses, questions about the car's behaviour (``why``), answers
+  to a confirmation (``yes`` / ``no``), negated requests; one line in seven (by a hash of
+  the text) is kept for calibration.
+* Everyday language (``everyday_train.csv.gz``, built by
+  ``scripts/build_everyday_corpus.py`` from corpora public packages ship): no command;
+  its ``calibration`` split is kept for calibration.
+* The development splits ``commands_test.csv`` and ``commands_blind.csv`` are calibrated on,
+  never trained on.
+
+The test split ``commands_heldout.csv`` and the external check ``everyday_check.csv.gz``
+are read by the evaluation only.
+"""
+
+from __future__ import annotations
+
+import csv
+import gzip
+import hashlib
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+from explaindrive.language.data import (
+    BLIND_CSV,
+    EVERYDAY_CHECK,
+    EVERYDAY_TRAIN,
+    TEST_CSV,
+    TRAIN_CSV,
+    WRITTEN_CSV,
+    data_path,
+)
+from explaindrive.language.intent.model import READINGS
+
+DEVELOPMENT = (TEST_CSV, BLIND_CSV)
+RESERVE = "reserve"
+WRITTEN_HOLDOUT = 7  # one written line in this many is kept for calibration
+
+
+@dataclass(frozen=True, slots=True)
+class Example:
+    """One labelled line: ``label`` is one of :data:`READINGS`; ``source`` says where it
+    comes from (a file name, or ``file:kind``)."""
+
+    text: str
+    label: str
+    source: str
+
+
+def read_lines(path: Path) -> list[dict[str, str]]:
+    """The rows of a CSV file, gzip-compressed or not.
+
+    Raises:
+        FileNotFoundError: if the file is missing.
+        ValueError: if it has no ``text`` column or an empty text (naming the line).
+    """
+    if not path.is_file():
+        raise FileNotFoundError(f"language data file not found: {path}")
+    raw = path.read_bytes()
+    text = gzip.decompress(raw).decode("utf-8") if path.suffix == ".gz" else raw.decode("utf-8")
+    reader = csv.DictReader(io.StringIO(text))
+    if reader.fieldnames is None or "text" not in reader.fieldnames:
+        raise ValueError(f"{path}: expected a CSV header with a text column")
+    rows = []
+    for line, row in enumerate(reader, start=2):
+        if not (row.get("text") or "").strip():
+            raise ValueError(f"{path}:{line}: empty text")
+        rows.append({k: (v or "").strip() for k, v in row.items() if k is not None})
+    return rows
+
+
+def _labelled(path: Path) -> list[tuple[Example, dict[str, str]]]:
+    out = []
+    for row in read_lines(path):
+        label = row.get("label", "").lower()
+        if label not in READINGS:
+            raise ValueError(f"{path}: unknown label {label!r} for {row['text']!r}")
+        out.append((Example(row["text"], label, f"{path.name}:{row.get('kind', '')}"), row))
+    return out
+
+
+def _held_out(text: str) -> bool:
+    digest = hashlib.sha256(text.lower().encode("utf-8")).hexdigest()
+    return int(digest, 16) % WRITTEN_HOLDOUT == 0
+
+
+def training_pool() -> tuple[list[Example], list[Example]]:
+    """The labelled lines and the everyday lines (label ``none``) LLM-1 is trained on."""
+    labelled = [e for e, row in _labelled(data_path(TRAIN_CSV)) if row.get("split") != RESERVE]
+    labelled += [e for e, _ in _labelled(data_path(WRITTEN_CSV)) if not _held_out(e.text)]
+    everyday = [
+        Example(row["text"], "none", f"{EVERYDAY_TRAIN}:{row['source']}")
+        for row in read_lines(data_path(EVERYDAY_TRAIN))
+        if row.get("split") == "train"
+    ]
+    return labelled, everyday
+
+
+def calibration_pool() -> list[Example]:
+    """The lines the thresholds are chosen on; none of them is trained on (a line that
+    also occurs in the training pool, such as a short reply, is left out)."""
+    labelled, everyday = training_pool()
+    trained = {e.text.lower() for e in labelled} | {e.text.lower() for e in everyday}
+    pool = [e for e, row in _labelled(data_path(TRAIN_CSV)) if row.get("split") == RESERVE]
+    pool += [e for e, _ in _labelled(data_path(WRITTEN_CSV)) if _held_out(e.text)]
+    for name in DEVELOPMENT:
+        pool += [e for e, _ in _labelled(data_path(name))]
+    pool += [
+        Example(row["text"], "none", f"{EVERYDAY_TRAIN}:{row['source']}")
+        for row in read_lines(data_path(EVERYDAY_TRAIN))
+        if row.get("split") == "calibration"
+    ]
+    return [e for e in pool if e.text.lower() not in trained]
+
+
+def external_check() -> list[str]:
+    """The external check's lines (everyday talk no model was trained or selected on)."""
+    return [row["text"] for row in read_lines(data_path(EVERYDAY_CHECK))]

@@ -1,0 +1,129 @@
+"""LLM-1's learned model: the adapters' merge, the decision rule, the file, the thresholds."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from explaindrive.language.intent.adapter import AdapterSpec, merge
+from explaindrive.language.intent.calibration import choose_thresholds, curve
+from explaindrive.language.intent.model import READINGS, IntentModel, Thresholds
+from explaindrive.language.intent.stop_path import names_stop
+
+LAYER = "encoder.layer.0.attention.self.query"
+
+
+THRESHOLDS = Thresholds(0.6, 0.7)
+
+
+def _model(thresholds: Thresholds = THRESHOLDS) -> IntentModel:
+    a = np.array([[1.0, 0.0, 2.0]], np.float32)  # rank 1, in 3
+    b = np.array([[1.0], [0.0]], np.float32)  # out 2
+    head_w = np.zeros((len(READINGS), 2), np.float32)
+    return IntentModel(
+        {LAYER: (a, b)}, AdapterSpec(1, 2.0), head_w, np.zeros(len(READINGS), np.float32),
+        thresholds, "0" * 64,
+    )  # fmt: skip
+
+
+def test_merge_adds_the_scaled_low_rank_change() -> None:
+    w = np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], np.float32)
+    model = _model()
+    merged = merge({f"{LAYER}.weight": w, "other": w}, model.adapters, model.spec)
+    # scale 2: B A = [[1, 0, 2], [0, 0, 0]] -> W + 2 B A
+    np.testing.assert_array_equal(merged[f"{LAYER}.weight"], [[3, 2, 7], [4, 5, 6]])
+    np.testing.assert_array_equal(merged["other"], w)
+
+
+def test_merge_refuses_an_adapter_that_does_not_fit() -> None:
+    model = _model()
+    with pytest.raises(ValueError, match="do not fit"):
+        merge({f"{LAYER}.weight": np.zeros((2, 4))}, model.adapters, model.spec)
+    with pytest.raises(ValueError, match="no weight"):
+        merge({"x.weight": np.zeros((2, 3))}, model.adapters, model.spec)
+
+
+def _p(**probs: float) -> np.ndarray:
+    p = np.zeros(len(READINGS))
+    for name, v in probs.items():
+        p[READINGS.index(name)] = v
+    return p
+
+
+@pytest.mark.parametrize(
+    ("probs", "reading", "abstained"),
+    [
+        ({"stop": 0.7, "fast": 0.3}, "stop", False),  # STOP at its threshold
+        ({"stop": 0.69, "none": 0.31}, "none", True),  # STOP below it: no command
+        ({"fast": 0.6, "none": 0.4}, "fast", False),  # a command at the threshold
+        ({"fast": 0.59, "none": 0.41}, "none", True),  # below it: abstain
+        ({"why": 0.5, "fast": 0.3, "none": 0.2}, "why", False),
+        ({"yes": 0.9, "no": 0.1}, "yes", False),
+    ],
+)
+def test_decide_gives_a_command_only_above_its_threshold(
+    probs: dict[str, float], reading: str, abstained: bool
+) -> None:
+    r = _model().decide(_p(**probs))
+    assert (r.reading, r.abstained) == (reading, abstained)
+    assert r.command == (reading if reading in ("fast", "comfort", "stop") else None)
+
+
+def test_the_model_file_round_trips_and_refuses_a_bad_one(tmp_path) -> None:
+    model = _model()
+    model.save(tmp_path / "m.npz")
+    back = IntentModel.load(tmp_path / "m.npz")
+    assert back.thresholds == model.thresholds and back.spec == model.spec
+    np.testing.assert_array_equal(back.adapters[LAYER][0], model.adapters[LAYER][0])
+    assert back.digest() == model.digest()
+    (tmp_path / "bad.npz").write_bytes(b"not a zip")
+    with pytest.raises(ValueError, match="not a valid intent model"):
+        IntentModel.load(tmp_path / "bad.npz")
+    with pytest.raises(FileNotFoundError):
+        IntentModel.load(tmp_path / "missing.npz")
+
+
+def test_thresholds_weigh_missed_stops_and_bound_false_commands() -> None:
+    model = _model()
+    # 2,000 lines without a command: one at p(stop) 0.95, one at 0.5; 20 with p(fast)
+    # 0.55 and 21 with p(fast) 0.45, the most probable reading of their rows
+    rows = [_p(none=1.0)] * 1957 + [_p(stop=0.95, none=0.05), _p(stop=0.5, none=0.5)]
+    rows += [_p(fast=0.55, none=0.45)] * 20 + [_p(fast=0.45, none=0.35, why=0.2)] * 21
+    labels = ["none"] * 2000
+    rows += [_p(fast=0.9, none=0.1), _p(comfort=0.5, none=0.5)]
+    labels += ["fast", "comfort"]
+    t, report = choose_thresholds(model, np.array(rows), labels)
+    # STOP: no STOP request, so the cost is the false STOPs: 2 up to 0.50, 1 up to 0.95,
+    # 0 from 0.96
+    assert t.stop == pytest.approx(0.96)
+    # command: up to 0.45 the 41 fast lines get a command, 2.05 % of 2,000 > 2 %; from
+    # 0.46 the 20 at 0.55 (1 %)
+    assert t.command == pytest.approx(0.46)
+    points = {round(pt.threshold, 2): pt for pt in curve(model, np.array(rows), labels, t.stop)}
+    assert points[0.45].false_command == pytest.approx(41 / 2000)
+    assert points[0.46].false_command == pytest.approx(20 / 2000)
+    assert points[0.46].coverage == pytest.approx(1.0)  # both commands still answered
+    assert points[0.46].risk == pytest.approx(20 / 22)  # 20 of the 22 given are wrong
+    assert points[0.56].false_command == 0.0
+    assert points[0.56].coverage == pytest.approx(0.5)
+    assert "STOP threshold 0.96, command threshold 0.46" in report
+    # two STOP requests at 0.6 and 0.45: up to 0.45 the cost is 0 + 2 false STOPs, at
+    # 0.46-0.50 5 + 2, 0.51-0.60 5 + 1, then 10 + 1 and, from 0.96, 10 + 0
+    rows += [_p(stop=0.6, none=0.4), _p(stop=0.45, none=0.55)]
+    labels += ["stop", "stop"]
+    assert choose_thresholds(model, np.array(rows), labels)[0].stop == pytest.approx(0.30)
+
+
+@pytest.mark.parametrize(
+    ("text", "named"),
+    [
+        ("Pull over, I'm going to be sick", True),
+        ("please let me out here", True),
+        ("drop me off here thanks", True),
+        ("This is an emergency!", True),
+        ("I can't stop thinking about that film", False),
+        ("the pullover is in the boot", False),
+    ],
+)
+def test_the_stop_path_names_its_phrases_only(text: str, named: bool) -> None:
+    assert names_stop(text) is named
