@@ -119,6 +119,11 @@ BATTERY: list[tuple[list[str], str]] = [
     (["scenario", "plot", "--out", "adir"], "error: --out adir is a folder; name a file"),
     (["report", "--out", "adir"], "error: --out adir is a folder; name a file"),
     (["report", "--external", "nope.json"], "error: evaluation file not found: nope.json"),
+    (["report", "--runs", "nope"], "error: --runs nope: no such folder"),
+    (
+        ["report", "--runs", "adir", "--policies", "comfort,krauss"],
+        "error: --runs adir: no training log adir/comfort/episodes.csv",
+    ),
     (
         ["report", "--json", "afile/r.json"],
         "error: --json afile/r.json: afile is a file, not a folder",

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from explaindrive.cli import _grid_options as grid
-from explaindrive.cli._errors import print_error
+from explaindrive.cli._errors import print_error, refuse
 from explaindrive.cli._grid_options import err_console
 from explaindrive.cli._paths import refuse_bad_outputs
 from explaindrive.evaluation.spec import POLICY_NAMES
@@ -92,6 +92,7 @@ def report_command(
     )
     plan = _plan(policies, episodes_per_cell, traffic, fast_policy, comfort_policy, max_steps,
                  shield, ray, ray_address, seed_tables or [])  # fmt: skip
+    training_logs = _training_logs(plan, runs_dir)
     try:
         stored = external_runs(plan, external or [])
     except ValueError as exc:
@@ -101,7 +102,7 @@ def report_command(
     err_console.print(f"report: {len(plan.runs)} runs, {n} episodes")
     with grid.episode_progress("episodes", n) as progress:
         result = run_report(
-            plan, out, figures_dir=figures, training_runs=_training_logs(plan, runs_dir),
+            plan, out, figures_dir=figures, training_runs=training_logs,
             json_file=json_file, workers=workers, use_ray=ray, ray_address=ray_address,
             command_line="explaindrive " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
             progress=progress, seed_tables=seed_tables or [], external=stored,
@@ -158,14 +159,22 @@ def _plan(
 
 
 def _training_logs(plan: ReportPlan, runs_dir: Path | None) -> dict[str, Path]:
-    """``episodes.csv`` of each agent: from ``runs_dir``, else the shipped training logs."""
+    """``episodes.csv`` of each agent: from ``runs_dir``, else the shipped training logs.
+
+    A ``runs_dir`` that is not a folder, or lacks the log of an agent of the plan, ends the
+    command at once with one line and status 2 (before any episode is run).
+    """
     from explaindrive.agent.controller import shipped_training_log
 
-    return {
-        name: (runs_dir / name / "episodes.csv" if runs_dir else shipped_training_log(name))
-        for name in plan.policies
-        if name in ("fast", "comfort")
-    }
+    agents = [name for name in plan.policies if name in ("fast", "comfort")]
+    if runs_dir is None:
+        return {name: shipped_training_log(name) for name in agents}
+    logs = {name: runs_dir / name / "episodes.csv" for name in agents}
+    if not runs_dir.is_dir():
+        refuse(f"--runs {runs_dir}: no such folder")
+    if missing := [path for path in logs.values() if not path.is_file()]:
+        refuse(f"--runs {runs_dir}: no training log {missing[0]}")
+    return logs
 
 
 def register(app: typer.Typer) -> None:
