@@ -17,6 +17,7 @@ class FakeSumo:
         persons: edge -> person ids on it.
         people: person id -> (x, y, angle_deg, speed_mps, next_edge).
         collisions: (collider, victim) pairs of this step.
+        links: the ego's signalled links, (tls id, link index, gap [m], state), nearest first.
     """
 
     def __init__(
@@ -26,6 +27,7 @@ class FakeSumo:
         persons: dict[str, tuple[str, ...]] | None = None,
         people: dict[str, tuple[float, float, float, float, str]] | None = None,
         collisions: tuple[tuple[str, str], ...] = (),
+        links: tuple[tuple[str, int, float, str], ...] = (),
     ) -> None:
         self.length_reads = 0
         vehicles, lights, persons, people = (
@@ -39,10 +41,10 @@ class FakeSumo:
             self.length_reads += 1
             return vehicles[vid][0]
 
-        self.vehicle = SimpleNamespace(getLength=length, getSpeed=lambda v: vehicles[v][1])
-        self.trafficlight = SimpleNamespace(
-            getSubscriptionResults=lambda t: {tc.TL_RED_YELLOW_GREEN_STATE: lights[t]}
+        self.vehicle = SimpleNamespace(
+            getLength=length, getSpeed=lambda v: vehicles[v][1], getNextTLS=lambda v: links
         )
+        self.trafficlight = SimpleNamespace(getRedYellowGreenState=lambda t: lights[t])
         self.edge = SimpleNamespace(
             getSubscriptionResults=lambda e: {tc.LAST_STEP_PERSON_ID_LIST: persons.get(e, ())}
         )

@@ -13,19 +13,19 @@ from explaindrive.env.perception import (
     Leader,
     LeaderSensor,
     LightReading,
-    LightSensor,
+    SignalLink,
     effective_leader,
+    light_ahead,
     observation,
+    signal_links,
 )
 from explaindrive.sim.crossing_lanes import CrossingLane
 from explaindrive.sim.pedestrians import KerbYield
-from explaindrive.sim.route import RouteCrossing, RouteLight
+from explaindrive.sim.route import RouteCrossing
 from tests.env.fake_sumo import FakeSumo, ego_results
 
-LIGHTS = (
-    RouteLight("J1", 100.0, (("e1_0", 2), ("e1_1", 3))),
-    RouteLight("J2", 400.0),
-)
+# a joined cluster C (two stop lines 37 m apart), then the light J2 far on
+LINKS = (("C", 6, 60.0, "G"), ("C", 16, 97.0, "r"), ("J2", 1, 360.0, "r"))
 ZEBRA = RouteCrossing(":Z_c0", (":Z_w0",), 250.0, signalized=False, end_m=262.0)
 SIGNAL = RouteCrossing(":J1_c0", (":J1_w0",), 100.0, signalized=True, end_m=112.0)
 # the ego lane runs from 3 m to 6 m along a 10 m crossing laid out west to east
@@ -43,16 +43,14 @@ def test_the_real_leader_gap_adds_the_ego_min_gap_and_lengths_are_read_once() ->
     assert sensor(api, ego_results(10.0, ("car", -4.0))).gap_m == 0.0  # overlap reads as 0
 
 
-def test_the_next_light_and_the_ego_link_by_lane() -> None:
-    api = FakeSumo(lights={"J1": "GGry", "J2": "rrrr"})
-    sensor = LightSensor(LIGHTS, tls_link={"J1": 0, "J2": 1})
-    assert sensor(api, 40.0, None) == LightReading(60.0, S.LightState.GREEN, "J1")  # link 0
-    assert sensor(api, 40.0, "e1_0").colour is S.LightState.RED  # lane e1_0 -> link 2
-    assert sensor(api, 40.0, "e1_1").colour is S.LightState.YELLOW  # lane e1_1 -> link 3
-    assert sensor(api, 40.0, "other").colour is S.LightState.GREEN  # entry link 0
-    assert sensor(api, 150.0, None) == LightReading()  # J2 at 250 m: beyond sensor range
-    assert sensor(api, 300.0, None) == LightReading(100.0, S.LightState.RED, "J2")
-    assert LightSensor(LIGHTS, tls_link={"J2": 1})(api, 40.0, None).light_id is None
+def test_the_light_ahead_is_the_nearest_link_of_the_ego_with_its_own_signal() -> None:
+    links = signal_links(FakeSumo(links=LINKS))
+    assert links[1] == SignalLink("C", 16, 97.0, "r")
+    assert light_ahead(links) == LightReading(60.0, S.LightState.GREEN, ("C", 6))
+    # past C's first stop line: its second, with its own signal (index 16 of programme C)
+    assert light_ahead(links[1:]) == LightReading(97.0, S.LightState.RED, ("C", 16))
+    assert light_ahead(links[2:]) == LightReading()  # J2 at 360 m: beyond sensor range
+    assert light_ahead(()) == LightReading()
 
 
 def test_a_pedestrian_in_the_ego_lane_makes_the_crossing_busy() -> None:

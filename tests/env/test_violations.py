@@ -2,27 +2,39 @@
 
 from __future__ import annotations
 
-from explaindrive.env.perception import CrossingSensor, LightSensor
+from explaindrive.env.perception import CrossingSensor, SignalLink
 from explaindrive.env.violations import ViolationJudge, Violations, ego_collided, speeding
 from tests.env.fake_sumo import FakeSumo
-from tests.env.test_perception import LANE, LIGHTS, ZEBRA
+from tests.env.test_perception import LANE, ZEBRA
+
+# the ego's links before the step: J1's 5 m ahead (index 2), then a joined cluster C whose
+# two stop lines lie 9 m and 12 m ahead (indices 6 and 16)
+LINKS = (SignalLink("J1", 2, 5.0, "G"), SignalLink("C", 6, 9.0, "G"),
+         SignalLink("C", 16, 12.0, "G"))  # fmt: skip
 
 
 def judge() -> ViolationJudge:
-    return ViolationJudge(
-        LightSensor(LIGHTS, tls_link={"J1": 0, "J2": 0}), CrossingSensor((ZEBRA,), {":Z_c0": LANE})
-    )
+    return ViolationJudge(CrossingSensor((ZEBRA,), {":Z_c0": LANE}))
 
 
 def test_crossing_a_red_stop_line_is_a_run_and_a_green_one_is_not() -> None:
-    red, green = FakeSumo(lights={"J1": "rGGG"}), FakeSumo(lights={"J1": "GrrG"})
-    assert judge().ran_red_light(red, 95.0, 100.0, None)  # the line at 100 m is crossed
-    assert not judge().ran_red_light(red, 100.0, 105.0, None)  # already past it
-    assert not judge().ran_red_light(red, 90.0, 99.0, None)  # still before it
-    assert not judge().ran_red_light(green, 95.0, 101.0, None)
-    assert not judge().ran_red_light(red, 95.0, 101.0, "e1_1")  # lane e1_1: link 3, green
-    assert judge().ran_red_light(green, 95.0, 101.0, "e1_0")  # lane e1_0: link 2, red
-    assert judge()(red, 95.0, 101.0, None, {}) == Violations(True, False)
+    # the colours after the step: J1's link 2 red, link 3 green
+    red, green = FakeSumo(lights={"J1": "GGrG"}), FakeSumo(lights={"J1": "rrGr"})
+    assert judge().ran_red_light(red, LINKS[:1], 5.0)  # the line 5 m ahead is crossed
+    assert not judge().ran_red_light(red, LINKS[:1], 4.9)  # still before it
+    assert not judge().ran_red_light(red, (SignalLink("J1", 2, 0.0, "r"),), 3.0)  # on it
+    assert not judge().ran_red_light(green, LINKS[:1], 6.0)
+    # the link read is the ego's own: link 3 of J1 is red in ``green``, but not the ego's
+    assert not judge().ran_red_light(green, (SignalLink("J1", 2, 5.0, "G"),), 6.0)
+    assert judge()(red, 95.0, 101.0, LINKS[:1], {}) == Violations(True, False)
+
+
+def test_each_stop_line_of_a_joined_cluster_is_judged_on_its_own_link() -> None:
+    # programme C: link 6 (its first stop line) green, link 16 (its second) red
+    api = FakeSumo(lights={"J1": "GGGG", "C": "G" * 6 + "G" + "G" * 9 + "r"})
+    assert not judge().ran_red_light(api, LINKS, 9.0)  # across J1 and C's first line only
+    assert judge().ran_red_light(api, LINKS, 12.0)  # and C's second, at red, in one step
+    assert not judge().ran_red_light(api, LINKS[2:], 11.9)
 
 
 def test_crossing_into_a_pedestrian_in_the_lane_is_a_yield_violation() -> None:

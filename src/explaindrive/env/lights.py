@@ -23,6 +23,7 @@ the decision has it, with no hard braking for a yellow it may legally drive thro
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from dataclasses import dataclass
 
 from explaindrive.env.actions import STOP_MARGIN_M, braking_distance, can_stop_before
@@ -55,8 +56,9 @@ def clears(speed_mps: float, d_tl: float) -> bool:
 class AmberDecision:
     """The ego's decision at the yellow of the light ahead, kept until that yellow ends."""
 
-    light_id: str | None = None
-    """The light the decision is about (``None``: no yellow decided)."""
+    light_id: Hashable | None = None
+    """The light the decision is about (``None``: no yellow decided); in the env, a
+    signalled link (its traffic light id and link index)."""
     stops: bool = True
     """Whether the ego stops for that light's yellow."""
     always: bool = False
@@ -65,7 +67,7 @@ class AmberDecision:
     """Decide by the ``gentle`` rule (module docstring) instead of the hardest braking."""
 
     def is_leader(
-        self, light_id: str | None, colour: LightState, speed_mps: float, d_tl: float
+        self, light_id: Hashable | None, colour: LightState, speed_mps: float, d_tl: float
     ) -> bool:
         """Whether the stop line of light ``light_id`` ahead is a virtual leader this step.
 

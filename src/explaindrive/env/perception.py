@@ -1,6 +1,11 @@
 """What the ego perceives each step: its leader, the next light, the next busy crossing, and
 the paper's 8-dim observation built from them.
 
+The lights are read link by link from SUMO (``vehicle.getNextTLS``): the stop line and the
+signal index of the link the ego will actually use, from the lane it is on, through its
+connection to the next edge of its route, with that connection's ``linkIndex`` in the
+programme. A joined cluster's several stop lines are each a link of their own.
+
 Each sensor is a small object that reads the running simulation and returns a value; none
 writes episode state. :class:`Perception` combines them into a :class:`Percept`.
 """
@@ -9,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import traci.constants as tc
@@ -20,7 +25,8 @@ from explaindrive.env import state as S
 from explaindrive.env.lights import AmberDecision
 from explaindrive.sim.crossing_lanes import CrossingLane, pedestrian_in_lane
 from explaindrive.sim.pedestrians import KerbYield
-from explaindrive.sim.route import RouteCrossing, RouteGeometry, RouteLight
+from explaindrive.sim.route import RouteCrossing, RouteGeometry
+from explaindrive.sim.scenario.files import EGO_ID
 
 JUDGE_CROSSING_M = S.MAX_SPEED_MPS + 5.0  # [m] a crossing this close may be entered next step
 _LOW: tuple[float, ...] = tuple(float(x) for x in S.STATE_LOW)
@@ -39,17 +45,17 @@ class Leader:
 
 @dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class LightReading:
-    """The next light of the ego's route within sensor range.
+    """The next signalled link of the ego's way within sensor range.
 
     Attributes:
         gap_m: from the ego's front to its stop line (sensor range: none).
         colour: its colour for the ego (green when none is in range).
-        light_id: its traffic light id (``None``: none in range).
+        light_id: its traffic light id and link index (``None``: none in range).
     """
 
     gap_m: float = S.SENSOR_RANGE_M
     colour: S.LightState = S.LightState.GREEN
-    light_id: str | None = None
+    light_id: tuple[str, int] | None = None
 
 
 NO_LIGHT = LightReading()
@@ -78,7 +84,7 @@ class Percept:
         obs: the raw observation (clipped to the state bounds).
         leader: the effective leader (real or virtual), ``None`` if none in range.
         real: the real leader, ``None`` if none in range.
-        lane_id: the ego's lane where SUMO changes its lanes (else ``None``).
+        links: the signalled links on the ego's way (:func:`signal_links`).
         crossings: the crossings ahead.
         light_colour: the true colour of the next light (the observation may show a yellow
             the ego goes through as green, :meth:`AmberDecision.shown_colour`).
@@ -87,7 +93,7 @@ class Percept:
     obs: NDArray[np.float32]
     leader: Leader | None
     real: Leader | None
-    lane_id: str | None
+    links: tuple[SignalLink, ...]
     crossings: CrossingReading
     light_colour: S.LightState = S.LightState.GREEN
 
@@ -117,36 +123,45 @@ class LeaderSensor:
         return Leader(max(gap, 0.0), float(api.vehicle.getSpeed(lid)), length, False)
 
 
-class LightSensor:
-    """The lights of the ego's route and the colours they show it.
+class SignalLink(NamedTuple):
+    """A signalled link on the ego's way, as SUMO reads it from the lane the ego is on.
 
-    Args:
-        lights: the route's lights, in route order.
-        tls_link: traffic light id -> the ego's link index there at entry.
+    The first is the link from the ego's lane (or from the lane SUMO keeps it on for its
+    route) into the next edge of the route; then every later one to the route's end. A
+    joined cluster (one programme for several nearby junctions) has several stop lines, so
+    one ``tls_id`` can come several times, each with the index of its own link.
+
+    Attributes:
+        tls_id: the traffic light (programme) that controls the link.
+        link_index: the link's index in that programme's state (its ``linkIndex``).
+        gap_m: from the ego's front to the link's stop line [m].
+        state: the link's signal this step (a character of SUMO's state string).
     """
 
-    def __init__(self, lights: tuple[RouteLight, ...], tls_link: dict[str, int]) -> None:
-        self.lights = lights
-        self.tls_link = tls_link
+    tls_id: str
+    link_index: int
+    gap_m: float
+    state: str
 
-    def colour(self, api: Any, light: RouteLight, lane_id: str | None) -> S.LightState:
-        """The colour ``light`` shows the ego: the link from the lane it is on when that lane
-        approaches the light, else the one it was routed through at entry."""
-        index = light.link_of(lane_id) if lane_id is not None else None
-        link = self.tls_link[light.tls_id] if index is None else index
-        states = api.trafficlight.getSubscriptionResults(light.tls_id)
-        return S.LightState.from_sumo(states[tc.TL_RED_YELLOW_GREEN_STATE][link])
 
-    def __call__(self, api: Any, pos_m: float, lane_id: str | None) -> LightReading:
-        """The next light ahead of route position ``pos_m`` (within sensor range)."""
-        for light in self.lights:
-            ahead = light.stop_line_m - pos_m
-            if ahead < 0.0 or light.tls_id not in self.tls_link:
-                continue
-            if ahead < S.SENSOR_RANGE_M:
-                return LightReading(ahead, self.colour(api, light, lane_id), light.tls_id)
-            break
-        return NO_LIGHT
+def signal_links(api: Any) -> tuple[SignalLink, ...]:
+    """The signalled links on the ego's way this step, nearest first."""
+    return tuple(SignalLink(*link) for link in api.vehicle.getNextTLS(EGO_ID))
+
+
+def light_ahead(links: tuple[SignalLink, ...]) -> LightReading:
+    """The reading of the nearest of ``links`` (:func:`signal_links`) within sensor range."""
+    if links and links[0].gap_m < S.SENSOR_RANGE_M:
+        link = links[0]
+        colour = S.LightState.from_sumo(link.state)
+        return LightReading(link.gap_m, colour, (link.tls_id, link.link_index))
+    return NO_LIGHT
+
+
+def link_colour(api: Any, link: SignalLink) -> S.LightState:
+    """The colour ``link`` shows now (read afresh: ``link.state`` is that of its step)."""
+    states = api.trafficlight.getRedYellowGreenState(link.tls_id)
+    return S.LightState.from_sumo(states[link.link_index])
 
 
 class CrossingSensor:
@@ -267,7 +282,6 @@ class Perception:
         geometry: the route's geometry.
         crossing_lanes: crossing edge -> the ego lane's stretch on it.
         leaders: the leader sensor.
-        tls_link: traffic light id -> the ego's link index there at entry.
     """
 
     def __init__(
@@ -275,11 +289,9 @@ class Perception:
         geometry: RouteGeometry,
         crossing_lanes: dict[str, CrossingLane],
         leaders: LeaderSensor,
-        tls_link: dict[str, int],
     ) -> None:
         self.geometry = geometry
         self.leaders = leaders
-        self.lights = LightSensor(geometry.lights, tls_link)
         self.crossings = CrossingSensor(geometry.crossings, crossing_lanes)
 
     def __call__(
@@ -302,9 +314,9 @@ class Perception:
             kerb: the pedestrians waiting for the ego at a zebra.
         """
         v = float(ego[tc.VAR_SPEED])
-        lane_id = ego.get(tc.VAR_LANE_ID)
         real = self.leaders(api, ego)
-        light = self.lights(api, pos_m, lane_id)
+        links = signal_links(api)
+        light = light_ahead(links)
         at_line = amber.is_leader(light.light_id, light.colour, v, light.gap_m)
         true_colour = light.colour
         shown = amber.shown_colour(true_colour, at_line)
@@ -314,4 +326,4 @@ class Perception:
         leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m)
         limit = self.geometry.posted_limit(pos_m)
         obs = observation(command, v, limit, leader, light, crossings.gap_m)
-        return Percept(obs, leader, real, lane_id, crossings, true_colour)
+        return Percept(obs, leader, real, links, crossings, true_colour)

@@ -30,7 +30,6 @@ from explaindrive.sim.scenario.files import (
 log = logging.getLogger(__name__)
 
 EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER)
-EGO_LANE_VARS = (*EGO_VARS, tc.VAR_LANE_ID)  # where SUMO changes the ego's lanes
 SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
@@ -47,13 +46,11 @@ class EgoEntry:
         start_pos_m: its front's position on its first lane [m].
         min_gap_m: its vType's minGap [m] (SUMO reports leader gaps minus it).
         length_m: its length [m].
-        tls_link: traffic light id -> the index of the ego's link there at entry.
     """
 
     start_pos_m: float
     min_gap_m: float
     length_m: float
-    tls_link: dict[str, int]
 
 
 @dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
@@ -86,7 +83,6 @@ class SumoProcess:
         self._conn = SumoConnection(gui=gui)
         self.ego_model = ego_model
         self.insert_timeout_s = insert_timeout_s
-        self._tls_link: dict[str, int] = {}  # kept while the network stays the same
 
     @property
     def api(self) -> Any:
@@ -96,7 +92,6 @@ class SumoProcess:
     def new_network(self) -> None:
         """Forget what was read from the current network and stop SUMO: the next episode
         starts it on another network."""
-        self._tls_link = {}
         self._conn.close()
 
     def close(self) -> None:
@@ -184,18 +179,13 @@ class SumoProcess:
         if model == "agent":
             api.vehicle.setSpeedMode(EGO_ID, 0)  # no car-following, light or right-of-way checks
             api.vehicle.setSpeed(EGO_ID, 0.0)
-        ego_vars = EGO_LANE_VARS if scenario.strategic_lane_changes else EGO_VARS
-        api.vehicle.subscribe(EGO_ID, ego_vars, parameters={tc.VAR_LEADER: S.SENSOR_RANGE_M})
-        if not self._tls_link:
-            self._tls_link = {t[0]: int(t[1]) for t in api.vehicle.getNextTLS(EGO_ID)}
-        for tls_id in self._tls_link:
-            api.trafficlight.subscribe(tls_id, (tc.TL_RED_YELLOW_GREEN_STATE,))
+        api.vehicle.subscribe(EGO_ID, EGO_VARS, parameters={tc.VAR_LEADER: S.SENSOR_RANGE_M})
         api.simulation.subscribe(SIM_VARS)
         for crossing in crossings:
             for edge in (crossing.crossing_edge, *crossing.walkingareas):
                 api.edge.subscribe(edge, (tc.LAST_STEP_PERSON_ID_LIST,))
         start_pos_m = float(api.vehicle.getLanePosition(EGO_ID))
-        return EgoEntry(start_pos_m, min_gap_m, length_m, dict(self._tls_link))
+        return EgoEntry(start_pos_m, min_gap_m, length_m)
 
     def _clear_entry(self, edge: str, drop_backlog: bool) -> None:
         """Remove background vehicles from the ego's entry stretch on ``edge`` (oversaturated

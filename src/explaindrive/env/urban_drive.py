@@ -180,13 +180,13 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise
         self._entry = entry
         leaders = LeaderSensor(entry.min_gap_m, self._leader_lengths)
-        perception = Perception(self.geometry, self._crossing_lanes, leaders, entry.tls_link)
+        perception = Perception(self.geometry, self._crossing_lanes, leaders)
         self._ep = ep = Episode(
             command=opts.command,
             schedule=list(opts.command_schedule),
             start_pos_m=entry.start_pos_m,
             perception=perception,
-            judge=ViolationJudge(perception.lights, perception.crossings),
+            judge=ViolationJudge(perception.crossings),
             pedestrians=PedestrianSource(int(sumo_seed), self.scenario.pedestrian_flows),
             amber=AmberDecision.for_rule(self.config.yellow_leader),
             noise=opts.noise if opts.noise is not None else self.config.noise,
@@ -230,7 +230,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         jerk = accel - ep.accel_mps2
         # violations are judged on what the ego saw before this step's observation
         assert seen is not None  # set by reset
-        violations = ep.judge(self._sumo.api, prev_pos, ep.pos_m, seen.lane_id,
+        violations = ep.judge(self._sumo.api, prev_pos, ep.pos_m, seen.links,
                               seen.crossings.in_lane)  # fmt: skip
         ep.speed_mps, ep.accel_mps2 = motion.speed_mps, accel
         ep.apply_schedule()

@@ -2,7 +2,9 @@
 
 Red lights and crossings are judged on what the ego saw before the step's observation: a
 violation is crossing a stop line during the step while the light was red, or while a
-pedestrian was in, or stepping into, the ego's lane on the crossing.
+pedestrian was in, or stepping into, the ego's lane on the crossing. A light is judged on
+the link the ego perceived (:func:`~explaindrive.env.perception.signal_links`): the stop
+line and signal index of its lane's link, as the observation reads them.
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from explaindrive.env.perception import CrossingSensor, LightSensor
+from explaindrive.env.perception import CrossingSensor, SignalLink, link_colour
 from explaindrive.env.state import LightState
 from explaindrive.sim.scenario.files import EGO_ID
 
@@ -39,12 +41,10 @@ class ViolationJudge:
     """Judges the ego's passage over the stop lines of its route.
 
     Args:
-        lights: the light sensor of the episode (the colours the ego's links show).
         crossings: the crossing sensor of the episode.
     """
 
-    def __init__(self, lights: LightSensor, crossings: CrossingSensor) -> None:
-        self.lights = lights
+    def __init__(self, crossings: CrossingSensor) -> None:
         self.crossings = crossings
 
     def __call__(
@@ -52,26 +52,31 @@ class ViolationJudge:
         api: Any,
         prev_pos_m: float,
         pos_m: float,
-        lane_id: str | None,
+        links: tuple[SignalLink, ...],
         in_lane: dict[str, bool],
     ) -> Violations:
         """The violations of a step that moved the ego's front from ``prev_pos_m`` to
-        ``pos_m`` (route positions [m]); ``lane_id`` and ``in_lane`` are what the ego
+        ``pos_m`` (route positions [m]); ``links`` and ``in_lane`` are what the ego
         perceived before the step (:class:`~explaindrive.env.perception.Percept`)."""
         return Violations(
-            self.ran_red_light(api, prev_pos_m, pos_m, lane_id),
+            self.ran_red_light(api, links, pos_m - prev_pos_m),
             self.crossed_occupied(api, prev_pos_m, pos_m, in_lane),
         )
 
-    def ran_red_light(self, api: Any, prev_pos_m: float, pos_m: float, lane_id: str | None) -> bool:
-        """The ego's front crossed a stop line during this step while the light was red.
+    @staticmethod
+    def ran_red_light(api: Any, links: tuple[SignalLink, ...], travelled_m: float) -> bool:
+        """The ego's front crossed the stop line of one of ``links`` (its links before the
+        step, nearest first) while travelling ``travelled_m`` this step, and that link's
+        light was red.
 
         SUMO switches signals at the start of a step and then moves the cars, so the
         colour read after the step is the one that held while the ego crossed.
         """
-        for light in self.lights.lights:
-            if prev_pos_m < light.stop_line_m <= pos_m and light.tls_id in self.lights.tls_link:
-                return self.lights.colour(api, light, lane_id) is LightState.RED
+        for link in links:
+            if link.gap_m > travelled_m:
+                break
+            if link.gap_m > 0.0 and link_colour(api, link) is LightState.RED:
+                return True
         return False
 
     def crossed_occupied(
