@@ -39,7 +39,7 @@ from explaindrive.env.actions import IDLE_ACTION, action_index, speed_change
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.reward import APPROACH_STANDSTILL_M
 from explaindrive.env.ride_quality import is_free_road
-from explaindrive.env.safety import VIRTUAL_TOL_M, safe_action_mask
+from explaindrive.env.safety import TRUE_VIRTUAL_TOL_M, safe_action_mask
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.evaluation.parsing import parse_levels, parse_seeds
 from explaindrive.evaluation.scenarios import PAPER_ROAD, ScenarioCase, parse_scenarios
@@ -53,7 +53,7 @@ def holds_for_light(obs: np.ndarray, decel_mps2: float) -> bool:
     at ``decel_mps2``."""
     v, d_tl = float(obs[S.V_EGO]), float(obs[S.D_TL])
     light_ahead = obs[S.TLS] != 0 and d_tl < S.SENSOR_RANGE_M
-    light_leads = abs(float(obs[S.D_LEAD]) - d_tl) < VIRTUAL_TOL_M
+    light_leads = abs(float(obs[S.D_LEAD]) - d_tl) < TRUE_VIRTUAL_TOL_M
     return bool(
         light_ahead and light_leads and v > 0
         and v * v / (2.0 * decel_mps2) <= d_tl - v - APPROACH_STANDSTILL_M

@@ -23,7 +23,7 @@ from explaindrive.env.actions import MAX_BRAKE_MPS, SPEED_CHANGES_MPS
 from explaindrive.env.safety import (
     HARDEST_BRAKE,
     LEADER_BRAKE_MPS,
-    VIRTUAL_TOL_M,
+    TRUE_VIRTUAL_TOL_M,
     limit_mask,
     runtime_mask,
     safe_action_mask,
@@ -34,7 +34,7 @@ from explaindrive.env.safety import (
 __all__ = [
     "HARDEST_BRAKE",
     "LEADER_BRAKE_MPS",
-    "VIRTUAL_TOL_M",
+    "TRUE_VIRTUAL_TOL_M",
     "ShieldDecision",
     "is_safe",
     "limit_mask",

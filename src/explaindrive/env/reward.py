@@ -54,7 +54,7 @@ FAST_SPEED_WEIGHT = 3.0
 COMFORT_SPEED_WEIGHT = 1.5
 STOP_REASON_GAP_M = 15.0  # [m] a leader this close justifies standing still
 GENTLE_BRAKE_MPS2 = 1.0  # [m/s^2] braking up to this is not charged by ``hard_brake``
-COMFORT_DECEL_MPS2 = 1.5  # [m/s^2] ``approach`` charges no stop needing up to this (default)
+APPROACH_FREE_DECEL_MPS2 = 1.5  # [m/s^2] ``approach`` charges no stop needing up to this (default)
 APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
 MAX_NEEDED_MPS2 = 9.0  # [m/s^2] SUMO's emergency braking: ``approach`` charges no further
 CRUISE_SHARE = 0.9  # of the posted limit: ``cruise`` charges free-road driving below it
@@ -93,7 +93,7 @@ class RewardWeights:
     jerk: float = 0.0
     hard_brake: float = 0.0
     approach: float = 0.0
-    approach_free_mps2: float = COMFORT_DECEL_MPS2
+    approach_free_mps2: float = APPROACH_FREE_DECEL_MPS2
     approach_time_gap_s: float = 0.0
     cruise: float = 0.0
     signal_stop: float = R_RESPECT
@@ -279,7 +279,7 @@ def approach_penalty(
     closing_speed_mps: float,
     weight: float,
     keep_m: float = 0.0,
-    free_mps2: float = COMFORT_DECEL_MPS2,
+    free_mps2: float = APPROACH_FREE_DECEL_MPS2,
 ) -> float:
     """-weight * (needed deceleration beyond ``free_mps2``)^2, stopping ``keep_m`` short of
     the standstill gap; the need is capped at :data:`MAX_NEEDED_MPS2`."""

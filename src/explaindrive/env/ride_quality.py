@@ -38,7 +38,7 @@ HARD_BRAKE_MPS2 = 3.0  # [m/s^2]
 FOLLOWING_M = 50.0  # [m]
 REVERSAL_MPS2 = 2.0  # [m/s^2]
 JERKY_MPS3 = 3.0  # [m/s^3]
-STANDSTILL_MPS = 0.1  # [m/s] at or below this the car stands
+RIDE_STANDSTILL_MPS = 0.1  # [m/s] at or below this SUMO's true speed stands (standstill gaps)
 _EPS = 1e-6
 
 
@@ -145,7 +145,7 @@ class RideQuality:
             self.free_road_speed_sum += share
             self.slow_free_road_steps += int(share < SLOW_SHARE)
         self._track_following(info, accel)
-        if speed <= STANDSTILL_MPS < prev:
+        if speed <= RIDE_STANDSTILL_MPS < prev:
             kind = signal_stop_kind(info)
             if kind == "light":
                 self.light_gaps.append(float(info["gap_m"]))

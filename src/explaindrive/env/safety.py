@@ -49,7 +49,7 @@ from explaindrive.env.actions import (
 )
 
 LEADER_BRAKE_MPS = 9.0  # [m/s per step] how hard a real leader may brake (SUMO emergency decel)
-VIRTUAL_TOL_M = 0.5  # [m] a leader this close to a stop line is the virtual leader
+TRUE_VIRTUAL_TOL_M = 0.5  # [m] in the true state: a leader this close to a stop line is virtual
 HARDEST_BRAKE = action_index(-MAX_BRAKE_MPS)
 _CHANGES = np.asarray(SPEED_CHANGES_MPS, dtype=np.float64)
 
@@ -172,8 +172,8 @@ def _unsafe(
         if not dilemma_braking:
             unsafe |= must_go & out.slows
 
-    virtual = (signal & (np.abs(gap - d_tl) <= VIRTUAL_TOL_M)) | (
-        np.abs(gap - d_cross) <= VIRTUAL_TOL_M
+    virtual = (signal & (np.abs(gap - d_tl) <= TRUE_VIRTUAL_TOL_M)) | (
+        np.abs(gap - d_cross) <= TRUE_VIRTUAL_TOL_M
     )
     real = (gap < S.SENSOR_RANGE_M) & ~virtual
     if _anywhere(real):
@@ -242,7 +242,8 @@ def _unsafe_one(values: list[float], dilemma_braking: bool, stop_progress: bool)
     must_go = light and tls == 1 and not least_need <= d_tl
     if light and not must_go:
         room = min(room, d_tl)
-    virtual = (signal and abs(gap - d_tl) <= VIRTUAL_TOL_M) or abs(gap - d_cross) <= VIRTUAL_TOL_M
+    tol = TRUE_VIRTUAL_TOL_M
+    virtual = (signal and abs(gap - d_tl) <= tol) or abs(gap - d_cross) <= tol
     if gap < S.SENSOR_RANGE_M and not virtual:
         leader_v = max(v - dv, 0.0)
         room = min(room, gap + float(braking_distances(leader_v, LEADER_BRAKE_MPS)))

@@ -11,7 +11,7 @@ from explaindrive.commands import Command
 from explaindrive.env import state as S
 from explaindrive.env.actions import SPEED_CHANGES_MPS, action_index
 
-COMFORT_DECEL_MPS2 = 2.5  # [m/s^2] planned braking of the cautious driver
+CAUTIOUS_PLAN_DECEL_MPS2 = 2.5  # [m/s^2] planned braking of the cautious driver
 STANDSTILL_GAP_M = 4.0  # [m] gap it keeps to a stopped leader
 
 
@@ -28,7 +28,7 @@ class CautiousDriver:
         if round(float(obs[S.CMD])) == Command.STOP:
             return action_index(-min(3, math.ceil(v)))
         room = max(0.0, float(obs[S.D_LEAD]) - STANDSTILL_GAP_M)
-        target = min(float(obs[S.V_LIM]), math.sqrt(2.0 * COMFORT_DECEL_MPS2 * room))
+        target = min(float(obs[S.V_LIM]), math.sqrt(2.0 * CAUTIOUS_PLAN_DECEL_MPS2 * room))
         change = int(np.clip(math.floor(target - v), SPEED_CHANGES_MPS[0], SPEED_CHANGES_MPS[-1]))
         return action_index(change)
 

@@ -21,7 +21,7 @@ from enum import StrEnum
 from explaindrive.commands import Command
 from explaindrive.language.explanation.hazards import (
     AT_LIMIT_MARGIN_MPS,
-    COMFORT_DECEL_MPS2,
+    HAZARD_COMFORT_DECEL_MPS2,
     HOLD_MARGIN_MPS,
     MIN_GAP_M,
     SHORT_HEADWAY_S,
@@ -36,8 +36,8 @@ from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M, RecordSt
 
 __all__ = [
     "AT_LIMIT_MARGIN_MPS",
-    "COMFORT_DECEL_MPS2",
     "EXPLAIN_TAG",
+    "HAZARD_COMFORT_DECEL_MPS2",
     "HOLD_MARGIN_MPS",
     "MIN_GAP_M",
     "NO_EXPLANATION_TAG",

@@ -142,7 +142,7 @@ _OPENERS: dict[str, tuple[str, ...]] = {
         "Sorry for speeding up so briskly",
     ),
 }
-STANDSTILL_MPS = 0.5  # [m/s] at or below this speed the car counts as stopped
+SEEN_STANDSTILL_MPS = 0.5  # [m/s] in the state seen, the car counts as stopped at or below this
 _REASONS: dict[Factor, tuple[str, ...]] = {
     Factor.PEDESTRIAN: (
         "because a pedestrian is crossing the street {d_cross} m ahead",
@@ -209,11 +209,11 @@ def opener_kind(record: StateRecord) -> str:
     """
     v = record.state.v_ego
     a = record.action
-    if v <= STANDSTILL_MPS and a <= 0:
+    if v <= SEEN_STANDSTILL_MPS and a <= 0:
         return "wait"
     if a > 0:
         return "accelerate"
-    if a < 0 and v + a <= STANDSTILL_MPS:
+    if a < 0 and v + a <= SEEN_STANDSTILL_MPS:
         return "stopping"
     if a < 0:
         return {-3: "hard_brake", -2: "firm_brake"}.get(a, "gentle_brake")

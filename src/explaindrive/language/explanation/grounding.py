@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import re
 
-from explaindrive.language.explanation.explainer import STANDSTILL_MPS, check_grounding
+from explaindrive.language.explanation.explainer import SEEN_STANDSTILL_MPS, check_grounding
 from explaindrive.language.explanation.hazards import Factor
 from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M, RecordState, StateRecord
 
@@ -86,8 +86,8 @@ def wording_problems(text: str, record: StateRecord) -> list[str]:
     """What ``text`` says the car does that its action and speed do not bear out."""
     v = record.state.v_ego
     a = record.action
-    moving = v > STANDSTILL_MPS
-    at_rest_after = v + a <= STANDSTILL_MPS
+    moving = v > SEEN_STANDSTILL_MPS
+    at_rest_after = v + a <= SEEN_STANDSTILL_MPS
     stop_ahead = a < 0 and _has_stop_target(record.state)
     rules = (
         (_STOPPED, at_rest_after, "a stop"),
@@ -96,8 +96,8 @@ def wording_problems(text: str, record: StateRecord) -> list[str]:
         (_HARD, a <= -2 and moving, "hard braking"),
         (_ACCELERATING, a > 0, "accelerating"),
         (_SLOWING, a < 0 and moving, "slowing down"),
-        (_HOLDING, a == 0 and v > STANDSTILL_MPS, "holding speed"),
-        (_WAITING, a <= 0 and v <= STANDSTILL_MPS, "waiting"),
+        (_HOLDING, a == 0 and v > SEEN_STANDSTILL_MPS, "holding speed"),
+        (_WAITING, a <= 0 and v <= SEEN_STANDSTILL_MPS, "waiting"),
     )
     rest = _STOPPED.sub(" ", text)  # a claimed stop is one problem, not two
     return [

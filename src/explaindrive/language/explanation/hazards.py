@@ -28,7 +28,7 @@ AT_LIMIT_MARGIN_MPS = 0.5  # [m/s] within this of the limit the limit explains b
 SHORT_HEADWAY_S = 2.0  # [s] time headway below which the leader is a safety reason
 SHORT_TTC_S = 5.0  # [s] time to collision below which the leader is a safety reason
 MIN_GAP_M = 10.0  # [m] a leader closer than this is always a safety reason
-COMFORT_DECEL_MPS2 = 2.0  # [m/s^2] comfortable braking
+HAZARD_COMFORT_DECEL_MPS2 = 2.0  # [m/s^2] comfortable braking, in explanations
 STANDSTILL_GAP_M = 2.0  # [m] gap kept to a stopped leader
 MIN_SPEED_MPS = 1.0  # [m/s] slower speeds count as this when timing a hazard
 CLOSING_MPS = 0.1  # [m/s] a leader is closing when the gap shrinks faster than this
@@ -85,7 +85,7 @@ class Hazard:
 
 def stopping_distance_m(v_mps: float) -> float:
     """Distance to stop from ``v_mps`` at the comfortable deceleration [m]."""
-    return v_mps**2 / (2.0 * COMFORT_DECEL_MPS2)
+    return v_mps**2 / (2.0 * HAZARD_COMFORT_DECEL_MPS2)
 
 
 def stop_line_slack_s(distance_m: float, v_mps: float) -> float:
@@ -114,7 +114,7 @@ def leader_slack_s(s: _State) -> float:
         return math.inf
     dv = s.dv or 0.0
     if dv > CLOSING_MPS:
-        return (s.d_lead - STANDSTILL_GAP_M - dv**2 / (2.0 * COMFORT_DECEL_MPS2)) / dv
+        return (s.d_lead - STANDSTILL_GAP_M - dv**2 / (2.0 * HAZARD_COMFORT_DECEL_MPS2)) / dv
     return s.d_lead / max(s.v_ego, MIN_SPEED_MPS)
 
 

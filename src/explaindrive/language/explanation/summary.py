@@ -40,7 +40,7 @@ LightLabel = Literal["green", "yellow", "red"]
 
 SUMMARY_CUTOFF_M = 50.0  # [m] objects farther than this are left out of summaries and decisions
 RESIDENTIAL_LIMIT_MPS = 30 / 3.6 + 0.05  # [m/s] limits up to 30 km/h are treated as residential
-VIRTUAL_LEADER_TOL_M = 2.0  # [m] a leader this close to a stop line is the env's virtual leader
+SEEN_VIRTUAL_LEADER_TOL_M = 2.0  # [m] in the noisy state seen: a leader this near a line is virtual
 
 _ACTION_TEXT: dict[int, str] = {
     -3: "braking hard (-3 m/s)",
@@ -130,9 +130,9 @@ class StateRecord(BaseModel):
         colour = LightState(s.tls) if light else None
         if lead:
             on_light = colour in (LightState.RED, LightState.YELLOW) and (
-                abs(s.d_lead - s.d_tl) <= VIRTUAL_LEADER_TOL_M
+                abs(s.d_lead - s.d_tl) <= SEEN_VIRTUAL_LEADER_TOL_M
             )
-            on_cross = cross and abs(s.d_lead - s.d_cross) <= VIRTUAL_LEADER_TOL_M
+            on_cross = cross and abs(s.d_lead - s.d_cross) <= SEEN_VIRTUAL_LEADER_TOL_M
             lead = not (on_light or on_cross)
         try:
             return cls(
