@@ -35,7 +35,7 @@ def test_scheduled_commands_switch_when_due() -> None:
 def step(leader: Leader | None, real: Leader | None) -> StepRecord:
     motion = Motion(10.0, collided=False, arrived=False, ego=None)
     return StepRecord(Command.FAST, 1, 1.0, -0.5, motion, leader, real, 13.89,
-                      Violations(red_light_run=True, ped_violation=False))  # fmt: skip
+                      Violations(True, False, "signal"))  # fmt: skip
 
 
 def test_features_are_taken_to_the_effective_leader() -> None:
@@ -55,7 +55,7 @@ def test_the_info_reports_the_step() -> None:
     rec = step(None, Leader(30.0, 6.0, 5.0, False))
     obs = np.array([0, 10, 13.89, 30, 4, 80, 2, 200], dtype=np.float32)
     crossings = CrossingReading(200.0, {})
-    ep.seen = Percept(obs, None, None, None, crossings, LightState.RED)
+    ep.seen = Percept(obs, None, None, (), crossings, LightState.RED)
     features = rec.features()
     terms = reward_terms(Command.FAST, features, RECIPES["paper"]).as_dict()
     info = rec.info(ep, obs, 13.89, features, terms)
@@ -65,7 +65,8 @@ def test_the_info_reports_the_step() -> None:
     # the info reports the light's true colour, also where the ego is shown another
     shown_green = obs.copy()
     shown_green[6] = 0
-    ep.seen = Percept(shown_green, None, None, None, crossings, LightState.YELLOW)
+    ep.seen = Percept(shown_green, None, None, (), crossings, LightState.YELLOW)
     assert rec.info(ep, shown_green, 13.89, features, terms)["light_state"] == "yellow"
     assert info["red_light_run"] and not info["ped_violation"] and not info["speeding"]
+    assert info["site"] == "signal"
     assert info["gap_m"] == math.inf and info["reward_terms"] == terms

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from explaindrive.env.metrics import EpisodeMetrics, stop_latency_bound
+from explaindrive.env.metrics import EpisodeMetrics, EpisodeResult, stop_latency_bound
 
 
 def info(
@@ -21,6 +21,7 @@ def info(
     ped=False,
     speeding=False,
     arrived=False,
+    site="free_road",
 ):
     return {
         "speed_mps": speed,
@@ -34,6 +35,7 @@ def info(
         "red_light_run": red,
         "ped_violation": ped,
         "speeding": speeding,
+        "site": site,
         "arrived": arrived,
         "accel_mps2": 0.0,
         "posted_limit_mps": 13.89,
@@ -62,6 +64,29 @@ def test_episode_figures():
     assert r.violations == 2
     assert r.travel_time_s == 4.0 and r.distance_m == 24.0
     assert r.total_reward == pytest.approx(-6.5)
+
+
+def test_violations_are_split_by_site() -> None:
+    m = EpisodeMetrics()
+    m.update(info(6.0, speeding=True, red=True, site="signal"))
+    m.update(info(6.0, speeding=True, site="signal"))  # still speeding inside the junction
+    m.update(info(5.0, ped=True, site="crossing"))
+    m.update(info(5.0, collision=True, site="yield_junction"))
+    m.update(info(15.0, speeding=True))
+    m.update(info(12.0, site="signal"))  # a site with nothing wrong counts nothing
+    r = m.result()
+    assert (r.collisions, r.red_light_runs, r.ped_violations, r.speeding_steps) == (1, 1, 1, 3)
+    zero = {"collisions": 0, "red_light_runs": 0, "ped_violations": 0, "speeding_steps": 0}
+    assert r.violations_by_site == {
+        "signal": {**zero, "red_light_runs": 1, "speeding_steps": 2},
+        "yield_junction": {**zero, "collisions": 1},
+        "crossing": {**zero, "ped_violations": 1},
+        "free_road": {**zero, "speeding_steps": 1},
+    }
+    assert EpisodeResult.from_dict(r.as_dict()) == r
+    old = r.as_dict()
+    del old["violations_by_site"]  # a file written before sites were recorded
+    assert EpisodeResult.from_dict(old).violations_by_site == {}
 
 
 def test_stop_latency_counts_steps_to_standstill():

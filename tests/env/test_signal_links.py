@@ -14,6 +14,7 @@ import pytest
 
 from explaindrive.env import state as S
 from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.sim.route import RouteJunction
 from explaindrive.sim.sumo_home import sumo_binary
 from tests.conftest import GRID_WITH_LIGHTS
 
@@ -107,6 +108,11 @@ def test_each_stop_line_of_a_joined_cluster_is_read_with_its_own_link(
 ) -> None:
     env = make_env(net_file=dual_carriageway, route=("WJ1", "J2E"), ego_model="krauss",
                    max_steps=200, warmup_s=60)  # fmt: skip
+    # both junctions' areas run from their stop lines over internal lanes of 11.5 m and 11.2 m
+    assert env.geometry.junctions == (
+        RouteJunction("J1", J1_LINE_M, J1_LINE_M + 11.5, signalized=True, crossing=False),
+        RouteJunction("J2", J2_LINE_M, J2_LINE_M + 11.2, signalized=True, crossing=False),
+    )
     obs, _ = env.reset(seed=0)
     api = env.sumo
     assert api.vehicle.getLaneID("ego") == "WJ1_0"  # the left lane only turns left

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from explaindrive.env.perception import CrossingSensor, SignalLink
 from explaindrive.env.violations import ViolationJudge, Violations, ego_collided, speeding
+from explaindrive.sim.route import RouteGeometry, RouteJunction
 from tests.env.fake_sumo import FakeSumo
 from tests.env.test_perception import LANE, ZEBRA
 
@@ -13,8 +14,19 @@ LINKS = (SignalLink("J1", 2, 5.0, "G"), SignalLink("C", 6, 9.0, "G"),
          SignalLink("C", 16, 12.0, "G"))  # fmt: skip
 
 
+# the route's junctions: a light at 100-112 m, the zebra's at 250-262 m, a priority
+# junction at 400-410 m
+JUNCTIONS = (
+    RouteJunction("J1", 100.0, 112.0, signalized=True, crossing=False),
+    RouteJunction("Z", 250.0, 262.0, signalized=False, crossing=True),
+    RouteJunction("P", 400.0, 410.0, signalized=False, crossing=False),
+)
+GEOMETRY = RouteGeometry(("a", "b"), (0.0, 112.0), 600.0, (0.0,), (13.89,), (), (ZEBRA,),
+                         JUNCTIONS)  # fmt: skip
+
+
 def judge() -> ViolationJudge:
-    return ViolationJudge(CrossingSensor((ZEBRA,), {":Z_c0": LANE}))
+    return ViolationJudge(CrossingSensor((ZEBRA,), {":Z_c0": LANE}), GEOMETRY)
 
 
 def test_crossing_a_red_stop_line_is_a_run_and_a_green_one_is_not() -> None:
@@ -26,7 +38,7 @@ def test_crossing_a_red_stop_line_is_a_run_and_a_green_one_is_not() -> None:
     assert not judge().ran_red_light(green, LINKS[:1], 6.0)
     # the link read is the ego's own: link 3 of J1 is red in ``green``, but not the ego's
     assert not judge().ran_red_light(green, (SignalLink("J1", 2, 5.0, "G"),), 6.0)
-    assert judge()(red, 95.0, 101.0, LINKS[:1], {}) == Violations(True, False)
+    assert judge()(red, 95.0, 101.0, LINKS[:1], {}) == Violations(True, False, "signal")
 
 
 def test_each_stop_line_of_a_joined_cluster_is_judged_on_its_own_link() -> None:
@@ -44,6 +56,20 @@ def test_crossing_into_a_pedestrian_in_the_lane_is_a_yield_violation() -> None:
     assert judge().crossed_occupied(busy, 245.0, 252.0, {})  # in the lane after the step
     assert not judge().crossed_occupied(empty, 245.0, 252.0, {":Z_c0": False})
     assert not judge().crossed_occupied(busy, 251.0, 258.0, {":Z_c0": True})  # line behind
+
+
+def test_each_step_has_the_site_of_its_violations_or_of_the_ego() -> None:
+    people = {"p": (4.0, 0.0, 90.0, 1.2, ":Z_c0")}
+    empty = FakeSumo(lights={"J1": "GGGG"}, people=people)
+    steps = ((90.0, 99.9), (95.0, 100.0), (111.0, 112.0), (240.0, 255.0), (400.0, 409.9))
+    site = [judge()(empty, prev, pos, (), {}).site for prev, pos in steps]
+    assert site == ["free_road", "signal", "free_road", "crossing", "yield_junction"]
+    # a red-light run counts at its signal, a pedestrian-yield violation at its crossing,
+    # wherever the ego's front ends the step
+    red = FakeSumo(lights={"J1": "GGrG"})
+    assert judge()(red, 95.0, 115.0, LINKS[:1], {}) == Violations(True, False, "signal")
+    ped = judge()(empty, 245.0, 265.0, (), {":Z_c0": True})
+    assert ped == Violations(False, True, "crossing")
 
 
 def test_collisions_and_speeding() -> None:

@@ -137,3 +137,30 @@ def test_shield_line_gives_the_share() -> None:
         "Safety shield: replaced the network's action in 3 of 400 steps (0.75 %)."
     )
     assert "would have replaced (shield off)" in shield_line(0, 0, False)
+
+
+def test_violations_by_site_are_summed_and_tabled() -> None:
+    from explaindrive.env.metrics import no_violations_by_site
+    from explaindrive.evaluation.tables import site_table
+
+    a, b = no_violations_by_site(), no_violations_by_site()
+    a["signal"]["red_light_runs"], a["free_road"]["speeding_steps"] = 2, 10
+    b["signal"]["speeding_steps"], b["yield_junction"]["collisions"] = 3, 1
+    b["crossing"]["ped_violations"] = 1
+    agg = aggregate([result(violations_by_site=a), result(violations_by_site=b)])
+    assert agg.violations_by_site == {
+        "signal": {"collisions": 0, "red_light_runs": 2, "ped_violations": 0,
+                   "speeding_steps": 3},
+        "yield_junction": {"collisions": 1, "red_light_runs": 0, "ped_violations": 0,
+                           "speeding_steps": 0},
+        "crossing": {"collisions": 0, "red_light_runs": 0, "ped_violations": 1,
+                     "speeding_steps": 0},
+        "free_road": {"collisions": 0, "red_light_runs": 0, "ped_violations": 0,
+                      "speeding_steps": 10},
+    }  # fmt: skip
+    # an episode from a file written before sites were recorded: no split for the group
+    assert aggregate([result(violations_by_site=a), result()]).violations_by_site == {}
+    row = site_table([RunSummary("fast", agg, {})]).splitlines()[2]
+    assert row == "| fast | 0 / 2 / 0 / 3 | 1 / 0 / 0 / 0 | 0 / 0 / 1 / 0 | 0 / 0 / 0 / 10 |"
+    none = site_table([RunSummary("old", aggregate([result()]), {})]).splitlines()[2]
+    assert none == "| old | n/a | n/a | n/a | n/a |"

@@ -106,6 +106,16 @@ def test_evaluate_cli(
     assert json.loads(out.read_text())["runs"][0]["episodes"][0]["metrics"] == json.loads(
         json.dumps(first.as_dict())
     )
+    # violations split by site, in the JSON (episode and aggregate) and the printed table
+    doc = json.loads(out.read_text())["runs"][0]
+    by_site = doc["episodes"][0]["metrics"]["violations_by_site"]
+    assert sorted(by_site) == ["crossing", "free_road", "signal", "yield_junction"]
+    assert sum(n["red_light_runs"] for n in by_site.values()) == first.red_light_runs
+    assert sum(n["speeding_steps"] for n in by_site.values()) == first.speeding_steps
+    assert doc["aggregates"]["overall"]["violations_by_site"] == by_site
+    cells = [" / ".join(str(n) for n in by_site[site].values())
+             for site in ("signal", "yield_junction", "crossing", "free_road")]  # fmt: skip
+    assert f"| merged (fast:0-8,comfort:8-) | {' | '.join(cells)} |" in res.output
     assert (tmp_path / "figs" / "speed_profile.png").stat().st_size > 0
     assert (tmp_path / "figs" / "command_profile.png").stat().st_size > 0
 

@@ -203,6 +203,7 @@ def _print_tables(name: str, spec: PolicySpec, records: list[Any], episodes: boo
     out.print(tables.paper_table([summary]) + "\n")
     out.print(tables.level_table([summary]) + "\n")
     out.print(tables.safety_table([summary]) + "\n")
+    out.print(tables.site_table([summary]) + "\n")
     out.print(tables.ride_table([summary]) + "\n")
     if spec.kind != "baseline":
         overrides, steps = shield_counts(records)

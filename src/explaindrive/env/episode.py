@@ -175,6 +175,7 @@ class StepRecord:
             "red_light_run": self.violations.red_light_run,
             "ped_violation": self.violations.ped_violation,
             "speeding": speeding(v, legal_limit_mps),
+            "site": self.violations.site,
             "arrived": self.motion.arrived,
             "reward_terms": terms,
         }

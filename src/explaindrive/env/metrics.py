@@ -21,6 +21,10 @@ Definitions:
     travel time  seconds until the ego left the route (None if it did not)
     ride         the ride-quality figures (free-road speed, hard brakes, reversals, jerk
                  percentiles, standstill gaps): :mod:`explaindrive.env.ride_quality`
+    by site      the collisions, red-light runs, pedestrian-yield violations and speeding
+                 steps again, split by where they happened: at a signal, a junction without
+                 one, a pedestrian crossing without one, or on the free road
+                 (:data:`SITES`, judged by :mod:`explaindrive.env.violations`)
 """
 
 from __future__ import annotations
@@ -33,6 +37,18 @@ from explaindrive.env.ride_quality import RideQuality, RideQualityResult
 
 TTC_INTERACTION_S = 10.0  # [s] TTCs at or above this are not counted as interactions
 MOVING_SPEED_MPS = 1.0  # [m/s] headways are averaged over steps at or above this speed
+SITES: tuple[str, ...] = ("signal", "yield_junction", "crossing", "free_road")
+"""Where a step's violations happened (:mod:`explaindrive.env.violations` judges it)."""
+VIOLATION_KINDS: tuple[str, ...] = (
+    "collisions", "red_light_runs", "ped_violations", "speeding_steps",
+)  # fmt: skip
+"""The violation counts of :class:`EpisodeResult`, as split by site."""
+_INFO_FLAGS = ("collision", "red_light_run", "ped_violation", "speeding")  # in that order
+
+
+def no_violations_by_site() -> dict[str, dict[str, int]]:
+    """Site -> violation kind -> 0, for every site and kind."""
+    return {site: dict.fromkeys(VIOLATION_KINDS, 0) for site in SITES}
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,6 +71,9 @@ class EpisodeResult:
     travel_time_s: float | None
     total_reward: float
     ride: RideQualityResult = field(default_factory=lambda: RideQuality().result())
+    violations_by_site: dict[str, dict[str, int]] = field(default_factory=dict)
+    """Site -> kind -> count (module docstring); empty for an episode stored before sites
+    were recorded."""
 
     @property
     def violations(self) -> int:
@@ -66,6 +85,7 @@ class EpisodeResult:
         d = asdict(self)
         d["stop_latencies"] = list(self.stop_latencies)
         d["ride"] = self.ride.as_dict()
+        d["violations_by_site"] = {site: dict(n) for site, n in self.violations_by_site.items()}
         return d
 
     @classmethod
@@ -106,6 +126,7 @@ class EpisodeMetrics:
     _prev_command: str | None = None
     _unfinished: int = 0
     ride: RideQuality = field(default_factory=RideQuality)
+    by_site: dict[str, dict[str, int]] = field(default_factory=no_violations_by_site)
 
     def update(self, info: dict[str, Any], reward: float = 0.0) -> None:
         """Add one step's ``info`` (and reward)."""
@@ -122,6 +143,9 @@ class EpisodeMetrics:
         self.red_light_runs += int(bool(info["red_light_run"]))
         self.ped_violations += int(bool(info["ped_violation"]))
         self.speeding_steps += int(bool(info["speeding"]))
+        at_site = self.by_site[info["site"]]
+        for kind, flag in zip(VIOLATION_KINDS, _INFO_FLAGS, strict=True):
+            at_site[kind] += int(bool(info[flag]))
         self.distance_m = float(info["distance_m"])
         self.time_s = float(info["time_s"])
         self.arrived = self.arrived or bool(info.get("arrived", False))
@@ -168,6 +192,7 @@ class EpisodeMetrics:
             travel_time_s=self.time_s if self.arrived else None,
             total_reward=self.total_reward,
             ride=self.ride.result(),
+            violations_by_site={site: dict(n) for site, n in self.by_site.items()},
         )
 
 

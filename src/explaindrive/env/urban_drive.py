@@ -186,7 +186,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             schedule=list(opts.command_schedule),
             start_pos_m=entry.start_pos_m,
             perception=perception,
-            judge=ViolationJudge(perception.crossings),
+            judge=ViolationJudge(perception.crossings, self.geometry),
             pedestrians=PedestrianSource(int(sumo_seed), self.scenario.pedestrian_flows),
             amber=AmberDecision.for_rule(self.config.yellow_leader),
             noise=opts.noise if opts.noise is not None else self.config.noise,

@@ -5,6 +5,14 @@ violation is crossing a stop line during the step while the light was red, or wh
 pedestrian was in, or stepping into, the ego's lane on the crossing. A light is judged on
 the link the ego perceived (:func:`~explaindrive.env.perception.signal_links`): the stop
 line and signal index of its lane's link, as the observation reads them.
+
+Each step has a site (:data:`~explaindrive.env.metrics.SITES`), where its violations are
+counted: a red-light run at its signal; a pedestrian-yield violation at its crossing's
+junction (``signal`` where a light controls it, else ``crossing``); anything else where the
+ego's front is after the step: inside a junction's area (from its stop line to the next
+edge), ``signal``, ``crossing`` (an unsignalised junction with a pedestrian crossing over
+the route, such as a zebra) or ``yield_junction`` (any other junction without a light),
+else ``free_road``.
 """
 
 from __future__ import annotations
@@ -14,6 +22,7 @@ from typing import Any
 
 from explaindrive.env.perception import CrossingSensor, SignalLink, link_colour
 from explaindrive.env.state import LightState
+from explaindrive.sim.route import RouteCrossing, RouteGeometry
 from explaindrive.sim.scenario.files import EGO_ID
 
 SPEEDING_TOLERANCE_MPS = 1e-6  # [m/s] above the legal limit by more than this is speeding
@@ -31,10 +40,12 @@ def speeding(speed_mps: float, legal_limit_mps: float) -> bool:
 
 @dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class Violations:
-    """The stop-line violations of one step."""
+    """The stop-line violations of one step and the step's site (one of
+    :data:`~explaindrive.env.metrics.SITES`)."""
 
     red_light_run: bool
     ped_violation: bool
+    site: str = "free_road"
 
 
 class ViolationJudge:
@@ -42,10 +53,12 @@ class ViolationJudge:
 
     Args:
         crossings: the crossing sensor of the episode.
+        geometry: the route's geometry (its junctions give the sites).
     """
 
-    def __init__(self, crossings: CrossingSensor) -> None:
+    def __init__(self, crossings: CrossingSensor, geometry: RouteGeometry) -> None:
         self.crossings = crossings
+        self.geometry = geometry
 
     def __call__(
         self,
@@ -58,10 +71,32 @@ class ViolationJudge:
         """The violations of a step that moved the ego's front from ``prev_pos_m`` to
         ``pos_m`` (route positions [m]); ``links`` and ``in_lane`` are what the ego
         perceived before the step (:class:`~explaindrive.env.perception.Percept`)."""
-        return Violations(
-            self.ran_red_light(api, links, pos_m - prev_pos_m),
-            self.crossed_occupied(api, prev_pos_m, pos_m, in_lane),
-        )
+        red = self.ran_red_light(api, links, pos_m - prev_pos_m)
+        ped = self.crossed_occupied(api, prev_pos_m, pos_m, in_lane)
+        if red:
+            site = "signal"
+        elif ped:
+            crossing = self._crossed(prev_pos_m, pos_m)
+            site = "signal" if crossing is not None and crossing.signalized else "crossing"
+        else:
+            site = self.site_at(pos_m)
+        return Violations(red, ped, site)
+
+    def site_at(self, pos_m: float) -> str:
+        """The site of route position ``pos_m`` (module docstring)."""
+        junction = self.geometry.junction_at(pos_m)
+        if junction is None:
+            return "free_road"
+        if junction.signalized:
+            return "signal"
+        return "crossing" if junction.crossing else "yield_junction"
+
+    def _crossed(self, prev_pos_m: float, pos_m: float) -> RouteCrossing | None:
+        """The crossing whose stop line the ego's front crossed this step, if any."""
+        for crossing in self.crossings.crossings:
+            if prev_pos_m < crossing.stop_line_m <= pos_m:
+                return crossing
+        return None
 
     @staticmethod
     def ran_red_light(api: Any, links: tuple[SignalLink, ...], travelled_m: float) -> bool:
@@ -84,10 +119,10 @@ class ViolationJudge:
     ) -> bool:
         """The ego's front crossed a crossing's stop line during this step while a
         pedestrian was in, or stepping into, its lane (before or after the step)."""
-        for crossing in self.crossings.crossings:
-            if prev_pos_m < crossing.stop_line_m <= pos_m:
-                on_crossing = self.crossings.persons(api, crossing.crossing_edge)
-                return in_lane.get(crossing.crossing_edge, False) or (
-                    bool(on_crossing) and self.crossings.in_lane(api, crossing, on_crossing)
-                )
-        return False
+        crossing = self._crossed(prev_pos_m, pos_m)
+        if crossing is None:
+            return False
+        on_crossing = self.crossings.persons(api, crossing.crossing_edge)
+        return in_lane.get(crossing.crossing_edge, False) or (
+            bool(on_crossing) and self.crossings.in_lane(api, crossing, on_crossing)
+        )

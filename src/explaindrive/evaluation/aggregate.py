@@ -6,6 +6,9 @@ Conventions (as in the paper's table, which averages over its 25 episodes):
                                   have one (an episode without a leader has no TH)
     collisions                    episodes with an AV collision ("0/25")
     red-light / ped / speeding    totals over the episodes
+    violations by site            totals over the episodes, per site and kind (empty when
+                                  an episode of the group has no split, e.g. one read from
+                                  a file written before sites were recorded)
     stop latency                  over every finished stop of every episode [steps]
     travel time                   mean over the episodes in which the ego reached the end [s]
     ride quality                  pooled over the episodes' steps outside STOP: free-road
@@ -20,13 +23,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from explaindrive.env.metrics import EpisodeResult
+from explaindrive.env.metrics import EpisodeResult, no_violations_by_site
 from explaindrive.env.reward import STOP_WINDOW_M
 from explaindrive.env.ride_quality import RideQualityResult
 
@@ -69,6 +72,8 @@ class Aggregate:
     crossing_stops: int = 0
     crossing_stop_gap_mean_m: float | None = None
     stop_gap_in_window_share: float | None = None
+    violations_by_site: dict[str, dict[str, int]] = field(default_factory=dict)
+    """Site -> kind -> total (:data:`~explaindrive.env.metrics.VIOLATION_KINDS`)."""
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict."""
@@ -130,7 +135,20 @@ def aggregate(results: Sequence[EpisodeResult]) -> Aggregate:
         arrived=len(travel),
         travel_time_mean_s=mean(travel),
         **ride_quality([r.ride for r in results], math.fsum(r.distance_m for r in results)),
+        violations_by_site=violations_by_site(results),
     )
+
+
+def violations_by_site(results: Sequence[EpisodeResult]) -> dict[str, dict[str, int]]:
+    """The episodes' violations per site and kind, summed; empty if one has no split."""
+    if not results or any(not r.violations_by_site for r in results):
+        return {}
+    total = no_violations_by_site()
+    for r in results:
+        for site, counts in r.violations_by_site.items():
+            for kind, n in counts.items():
+                total[site][kind] += n
+    return total
 
 
 def ride_quality(rides: Sequence[RideQualityResult], distance_m: float) -> dict[str, Any]:

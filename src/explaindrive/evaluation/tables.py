@@ -111,6 +111,28 @@ def safety_table(summaries: Sequence[RunSummary]) -> str:
     return markdown_table(header, rows)
 
 
+SITE_HEADERS: dict[str, str] = {
+    "signal": "at a signal", "yield_junction": "at a junction without signal",
+    "crossing": "at a crossing without signal", "free_road": "on the free road",
+}  # fmt: skip
+"""Column header of each site (:data:`~explaindrive.env.metrics.SITES`)."""
+
+
+def site_table(summaries: Sequence[RunSummary]) -> str:
+    """Where the violations happened: per site, collisions / red-light runs / pedestrian-yield
+    violations / speeding steps (``n/a`` for a run with no split by site)."""
+    header = ["policy (collisions / red-light / ped-yield / speeding)", *SITE_HEADERS.values()]
+    rows = []
+    for s in summaries:
+        by_site = s.overall.violations_by_site
+        cells = [
+            " / ".join(str(n) for n in by_site[site].values()) if by_site else "n/a"
+            for site in SITE_HEADERS
+        ]
+        rows.append([s.name, *cells])
+    return markdown_table(header, rows)
+
+
 def ride_table(summaries: Sequence[RunSummary]) -> str:
     """What a passenger feels, outside STOP (definitions: ``env/ride_quality.py``)."""
     header = [

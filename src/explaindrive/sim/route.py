@@ -54,6 +54,17 @@ class RouteCrossing:
 
 
 @dataclass(frozen=True, slots=True)
+class RouteJunction:
+    """A junction the route passes, from its stop line to where its next edge starts."""
+
+    node_id: str
+    start_m: float  # [m] route position of the stop line (the end of the edge into it)
+    end_m: float  # [m] route position of the start of the edge out of it
+    signalized: bool  # a traffic light controls it
+    crossing: bool  # a pedestrian crossing over the route lies on it
+
+
+@dataclass(frozen=True, slots=True)
 class RouteGeometry:
     """Static geometry of the ego route."""
 
@@ -64,6 +75,14 @@ class RouteGeometry:
     zone_limit_mps: tuple[float, ...]  # [m/s] its limit
     lights: tuple[RouteLight, ...]
     crossings: tuple[RouteCrossing, ...]
+    junctions: tuple[RouteJunction, ...] = ()
+
+    def junction_at(self, pos_m: float) -> RouteJunction | None:
+        """The junction whose area (stop line to the next edge) holds ``pos_m``, if any."""
+        for junction in self.junctions:
+            if junction.start_m <= pos_m < junction.end_m:
+                return junction
+        return None
 
     def limit_at(self, pos_m: float) -> float:
         """Legal speed limit [m/s] at a route position."""
@@ -125,6 +144,7 @@ def load_route_geometry(
         for eid, nxt in itertools.pairwise(route_edges)
         if (tls_id := road.conns[(eid, nxt)].getTLSID())
     ]
+    crossings = _route_crossings(net, route_edges, layout)
     return RouteGeometry(
         edges=tuple(route_edges),
         edge_start_m=tuple(layout.starts),
@@ -132,7 +152,8 @@ def load_route_geometry(
         zone_start_m=tuple(layout.zone_start),
         zone_limit_mps=tuple(layout.zone_limit),
         lights=tuple(lights),
-        crossings=tuple(_route_crossings(net, route_edges, layout)),
+        crossings=tuple(crossings),
+        junctions=tuple(_route_junctions(net, route_edges, layout, crossings)),
     )
 
 
@@ -222,6 +243,21 @@ def _via_lanes(net: Any, conn: Any) -> Iterator[Any]:
         yield lane
         onward = [c.getViaLaneID() for c in lane.getOutgoing() if c.getViaLaneID()]
         via_id = onward[-1] if onward else ""
+
+
+def _route_junctions(
+    net: Any, route_edges: tuple[str, ...], layout: _Layout, crossings: list[RouteCrossing]
+) -> list[RouteJunction]:
+    """The junctions between the route's edges, in route order."""
+    zebra_edges = {c.approach_edge for c in crossings}
+    junctions = []
+    for i, (eid, _nxt) in enumerate(itertools.pairwise(route_edges)):
+        node = net.getEdge(eid).getToNode()
+        junctions.append(RouteJunction(
+            node_id=node.getID(), start_m=layout.end[eid], end_m=layout.starts[i + 1],
+            signalized=node.getType().startswith("traffic_light"), crossing=eid in zebra_edges,
+        ))  # fmt: skip
+    return junctions
 
 
 def _route_crossings(
