@@ -125,3 +125,41 @@ def test_score_intents_on_a_split_sweeps_the_trust_in_a_remote_model(  # type: i
     assert "trust_embedded_from" in res.output
     res = runner.invoke(app, ["score", "intents", "--data", str(data), "--split", "dev-2"])
     assert res.exit_code != 0 and "no rows of split 'dev-2'" in res.output
+
+
+def test_score_intents_on_off_topic_lines_only_reports_their_figures(  # type: ignore[no-untyped-def]
+    tmp_path, interpreter
+) -> None:
+    data = tmp_path / "offtopic.csv"
+    data.write_text(
+        "text,label\nWhat's the capital of Peru?,none\nI love this song.,none\n"
+        "My laptop is so slow today.,none\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "r.json"
+    res = runner.invoke(app, ["score", "intents", "--data", str(data), "--json", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "no command rows, off-topic figures only" in res.output
+    report = json.loads(out.read_text())
+    assert (report["n_commands"], report["n_none"], report["accuracy"]) == (0, 3, None)
+    assert report["none_rejection"] == 1.0 and report["none_read_as_stop"] == 0
+
+
+def test_score_everyday_counts_the_commands_given(tmp_path, interpreter) -> None:  # type: ignore[no-untyped-def]
+    data = tmp_path / "talk.csv"
+    data.write_text(
+        "text,source\nHow was your weekend?,me\nPull over right now!,me\nNice shoes.,me\n"
+        "Ha ha ha,me\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "r.json"
+    res = runner.invoke(app, ["score", "everyday", "--data", str(data), "--json", str(out)])
+    assert res.exit_code == 0, res.output
+    report = json.loads(out.read_text())
+    assert report["n"] == 4 and report["commands"]["stop"] == 1
+    assert report["left_without_command"] == 0.75  # 3 of 4
+    assert report["given"] == [{"text": "Pull over right now!", "command": "stop"}]
+    bad = tmp_path / "bad.csv"
+    bad.write_text("words\nhello\n", encoding="utf-8")
+    res = runner.invoke(app, ["score", "everyday", "--data", str(bad)])
+    assert res.exit_code != 0 and "text column" in res.output

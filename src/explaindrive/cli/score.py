@@ -72,9 +72,7 @@ def intents_command(
             rows = [r for r in rows if r.split == split]
             if not rows:
                 raise ValueError(f"{data}: no rows of split {split!r}")
-        from explaindrive.language.stack import make_language_stack
-
-        stack = make_language_stack(backend, load_config(config, model)).load()
+        stack = _stack(backend, config, model).load()
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_intents
@@ -153,9 +151,7 @@ def everyday_command(
         texts = [row["text"] for row in read_lines(data)]
         if not texts:
             raise ValueError(f"{data}: no rows")
-        from explaindrive.language.stack import make_language_stack
-
-        stack = make_language_stack(backend, load_config(config, model)).load()
+        stack = _stack(backend, config, model).load()
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_everyday
@@ -172,6 +168,17 @@ def everyday_command(
     for g in report["given"][:20]:
         console.print(f"  {g['command']:7s} {g['text'][:90]}", highlight=False)
     _write(out, report)
+
+
+def _stack(backend: str | None, config: Path | None, model: str | None) -> Any:
+    """The language stack of ``--backend``, ``--config`` and ``--model`` (not loaded).
+
+    Raises:
+        FileNotFoundError, ValueError: for a bad config or backend.
+    """
+    from explaindrive.language.stack import make_language_stack
+
+    return make_language_stack(backend, load_config(config, model))
 
 
 def _fmt(x: float | None) -> str:
@@ -197,9 +204,7 @@ def decisions_command(
     data = data or data_path(DECISIONS_JSONL)
     try:
         rows = load_decisions(data)
-        from explaindrive.language.stack import make_language_stack
-
-        stack = make_language_stack(backend, load_config(config, model))
+        stack = _stack(backend, config, model)
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     from explaindrive.language.evaluation import evaluate_decisions
