@@ -67,8 +67,8 @@ class ScriptedController:
 
 
 class KeywordInterpreter(IntentInterpreter):
-    """Maps keywords to commands, ``yes`` / ``no`` alone to answers; ``slow`` in the text
-    makes it sleep, ``crash`` raise."""
+    """Maps keywords to commands, ``yes`` / ``no`` alone to answers, a line starting with
+    ``why`` to a question; ``slow`` in the text makes it sleep, ``crash`` raise."""
 
     name = "fake"
     words: ClassVar[dict[str, Command]] = {
@@ -85,6 +85,8 @@ class KeywordInterpreter(IntentInterpreter):
             raise RuntimeError("model exploded")
         if "slow" in text:
             time.sleep(self.delay_s)
+        if text.strip().lower().startswith("why"):
+            return IntentResult(None, "Rephrase?", self.name, False, 0.0, {}, reading="why")
         if text.strip().lower() in ("yes", "no"):
             answer = text.strip().lower()
             return IntentResult(None, "Rephrase?", self.name, False, 0.0, {}, reading=answer)

@@ -120,6 +120,24 @@ def test_a_line_read_as_yes_answers_the_question_and_one_read_as_no_cancels():
     session.close()
 
 
+def test_a_why_question_is_answered_by_an_explanation_and_leaves_the_command():
+    session = make_session(max_steps=30)
+    session.start()
+    for _ in range(3):
+        session.step()
+    session.say("why are we going like this?")
+    for _ in range(5):
+        session.step()
+        time.sleep(0.02)
+    answers = [r for r in session.records if r.explanation and "question" in r.explanation]
+    assert len(answers) == 1 and answers[0].explanation["question"] == 1
+    assert answers[0].explanation["text"].startswith("slowing for")  # the fake explainer
+    assert (session.counts.questions, session.counts.requests, session.counts.rephrase) == (1, 0, 0)
+    assert session.pending_confirmation is None
+    assert all(r.command == "fast" for r in session.records)
+    session.close()
+
+
 def test_an_answer_read_before_its_question_waits_for_it():
     session = make_session(max_steps=60)
     session.start()

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
-from explaindrive.language.explanation.decision import Decision
+from explaindrive.language.explanation.decision import Decision, most_critical_factor
 from explaindrive.language.explanation.explainer import Explanation
 from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.ride.config import RideConfig
@@ -49,9 +49,11 @@ class Explanations:
         self.records = records
         self.latest: dict[str, Any] | None = None
         self._explained_at: dict[str | None, float] = {}  # factor -> when last explained
+        self._now: tuple[int, StateRecord] | None = None  # the newest step and its state
 
     def submit_decision(self, record: StepRecord, state_record: StateRecord) -> None:
         """Ask LLM-2 about the newest step, unless the explanation channel is still busy."""
+        self._now = (len(self.records) - 1, state_record)
         if self.lane.busy(EXPLANATION):
             self.counts.skipped_decisions += 1
             record.decision = {"explain": False, "skipped": "the explanation channel is busy"}
@@ -98,6 +100,26 @@ class Explanations:
             context=ExplainJob(job.step),
         )
 
+    def answer(self, question: int) -> bool:
+        """Have LLM-3 explain the newest step for the passenger's "why?" (request
+        ``question``): by the factor the rule engine would name, else the first braking
+        factor in the state, else none (what the car does and that it is safe). A question
+        is answered whatever the cool-down; ``False`` before the first step.
+        """
+        if self._now is None:
+            return False
+        step, state_record = self._now
+        self.counts.questions += 1
+        self.lane.submit(
+            TaskKind.EXPLAIN,
+            self.language.explainer.explain,
+            state_record,
+            most_critical_factor(state_record),
+            deadline_s=self.config.explain_deadline_s,
+            context=ExplainJob(step, question),
+        )
+        return True
+
     def on_explanation(self, job: ExplainJob, exp: Explanation, latency_s: float) -> None:
         """Write LLM-3's explanation (its task took ``latency_s`` [s]) into its step's record."""
         rec = self.records[job.step]
@@ -110,6 +132,8 @@ class Explanations:
         }
         if exp.raw_reply is not None:
             rec.explanation["raw_reply"] = exp.raw_reply
+        if job.question is not None:
+            rec.explanation["question"] = job.question
         rec.latency_s["explain"] = latency_s
         self.counts.explanations += 1
         self.counts.fallbacks += int(exp.fallback)

@@ -37,9 +37,11 @@ class DecideJob:
 
 @dataclass(frozen=True)
 class ExplainJob:
-    """Explain the step ``step`` (LLM-3)."""
+    """Explain the step ``step`` (LLM-3); ``question`` is the id of the passenger's "why?"
+    request it answers, ``None`` for an explanation LLM-2 decided on."""
 
     step: int
+    question: int | None = None
 
 
 LanguageJob = InterpretJob | DecideJob | ExplainJob

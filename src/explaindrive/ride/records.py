@@ -69,6 +69,7 @@ class RideCounts:
 
     requests: int = 0
     answers: int = 0
+    questions: int = 0
     understood: int = 0
     rephrase: int = 0
     confirmations: int = 0

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from explaindrive.commands import Command
-from explaindrive.language.intent.model import ANSWERS
+from explaindrive.language.intent.model import ANSWERS, WHY_READING
 from explaindrive.language.speech.transcriber import AudioError
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
@@ -71,6 +71,8 @@ class PassengerRequests:
         self._requests = 0
         self._newest_read = 0  # the latest request understood as a command
         self._held_answer: bool | None = None  # a yes/no heard before its question
+        self.on_question: Callable[[int], object] | None = None
+        """Answers a "why?" question (the request's id): set by the session."""
 
     def submit(self, line: PassengerInput, confirm: bool | None = None) -> int:
         """Queue a line for interpretation; returns its request id.
@@ -146,6 +148,10 @@ class PassengerRequests:
             return
         if result.reading in ANSWERS:
             self._hear_answer(result.reading == "yes")
+            return
+        if result.reading == WHY_READING and self.on_question is not None:
+            self.counts.requests -= 1  # a question, not a request: the command stays
+            self.on_question(req.id)
             return
         if result.intent is None:
             self.counts.rephrase += 1

@@ -93,6 +93,7 @@ class RideSession:
             clock=lambda: self.t,
         )  # fmt: skip
         self.explanations = Explanations(config, self.lane, language, self.counts, self.records)
+        self.requests.on_question = self.explanations.answer
 
     # ------------------------------------------------------------------ lifecycle
     def start(self, command: Command = Command.FAST) -> NDArray[np.float32]:

@@ -35,6 +35,8 @@ NONE, WHY, YES, NO = (READINGS.index(r) for r in ("none", "why", "yes", "no"))
 STOP = READINGS.index("stop")
 ANSWERS: tuple[str, ...] = ("yes", "no")
 """The readings that answer a confirmation question."""
+WHY_READING = "why"
+"""The reading of a question about what the car is doing."""
 N_COMMANDS = len(COMMAND_LABELS)
 ENCODER_WEIGHTS = "model.safetensors"
 
