@@ -136,11 +136,20 @@ function renderGauges() {
   ui.clock.textContent = f ? Math.round(f.t).toString() : "0";
 }
 
+// What the car says to a line it interpreted: its question for a command, a promise to
+// explain for a "why?", the answer for a yes or no.
+function describeReading(e) {
+  if (e.intent) return `Car: ${e.confirmation}`;
+  if (e.reading === "why") return "Car: Let me explain what I'm doing.";
+  if (e.reading === "yes" || e.reading === "no") return `You answered ${e.reading}.`;
+  return "Car: I did not understand that.";
+}
+
 function describeEvent(e) {
   switch (e.type) {
     case "line": return e.text ? `You: “${e.text}”` : "You: (recording)";
     case "transcript": return e.text ? `Heard: “${e.text}”` : "Heard nothing";
-    case "interpretation": return e.intent ? `Car: ${e.confirmation}` : "Car: I did not understand that.";
+    case "interpretation": return describeReading(e);
     case "confirmed": return `Command ${e.from} → ${e.to}`;
     case "cancelled": return `Cancelled; keeping ${e.kept_command}`;
     case "rephrase": return `Car: ${e.message}`;
