@@ -109,7 +109,6 @@ class Explanations:
         if self._now is None:
             return False
         step, state_record = self._now
-        self.counts.questions += 1
         self.lane.submit(
             TaskKind.EXPLAIN,
             self.language.explainer.explain,

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from explaindrive.commands import Command
-from explaindrive.language.intent.model import ANSWERS, WHY_READING
+from explaindrive.language.intent.model import WHY_READING, answer_of
 from explaindrive.language.speech.transcriber import AudioError
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
@@ -146,11 +146,13 @@ class PassengerRequests:
         self._note_heard(req, heard, latency_s)
         if result is None:
             return
-        if result.reading in ANSWERS:
-            self._hear_answer(result.reading == "yes")
+        answer = answer_of(result.reading)
+        if answer is not None:
+            self._hear_answer(answer)
             return
         if result.reading == WHY_READING and self.on_question is not None:
             self.counts.requests -= 1  # a question, not a request: the command stays
+            self.counts.questions += 1
             self.on_question(req.id)
             return
         if result.intent is None:

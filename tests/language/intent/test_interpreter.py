@@ -10,6 +10,7 @@ from explaindrive.language.intent.interpreter import (
     format_confirmation,
     parse_confirmation,
 )
+from explaindrive.language.intent.model import answer_of
 
 
 def test_template_round_trip() -> None:
@@ -38,7 +39,7 @@ def test_template_round_trip() -> None:
     ],
 )
 def test_confirmation_answers(interpreter, answer: str, expected: bool | None) -> None:  # type: ignore[no-untyped-def]
-    assert interpreter.read_answer(answer) is expected
+    assert answer_of(interpreter.interpret(answer).reading) is expected
 
 
 @pytest.mark.parametrize(

@@ -86,14 +86,6 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
             reading=reading.reading,
         )
 
-    def read_answer(self, text: str) -> bool | None:
-        """The passenger's answer to a confirmation question: ``True`` for yes, ``False``
-        for no, ``None`` when the line is neither (a new request, say)."""
-        if not text or not text.strip():
-            return None
-        (reading,) = self.reader.read([text])
-        return {"yes": True, "no": False}.get(reading.reading)
-
 
 def command_scores(reading: Reading) -> dict[str, float]:
     """The probabilities of the three commands and of ``none``, every reading that asks for

@@ -28,13 +28,21 @@ from explaindrive.cache import cache_dir, is_complete, publish
 from explaindrive.commands import COMMAND_LABELS
 from explaindrive.language.data import INTENT_MODEL, data_path
 from explaindrive.language.intent.adapter import AdapterSpec, merge
+from explaindrive.language.packaged import file_sha256
 
 READINGS: tuple[str, ...] = (*COMMAND_LABELS, "none", "why", "yes", "no")
 """What a line can mean; the first three are the commands (:mod:`explaindrive.commands`)."""
-NONE, WHY, YES, NO = (READINGS.index(r) for r in ("none", "why", "yes", "no"))
 STOP = READINGS.index("stop")
 ANSWERS: tuple[str, ...] = ("yes", "no")
 """The readings that answer a confirmation question."""
+
+
+def answer_of(reading: str | None) -> bool | None:
+    """The answer a reading gives to a confirmation question: ``True`` for ``yes``,
+    ``False`` for ``no``, ``None`` for any other reading (a new request, say)."""
+    return {"yes": True, "no": False}.get(reading or "")
+
+
 WHY_READING = "why"
 """The reading of a question about what the car is doing."""
 N_COMMANDS = len(COMMAND_LABELS)
@@ -207,7 +215,8 @@ class IntentModel:
         from safetensors.numpy import load_file, save_file
 
         weights_file = base_dir / ENCODER_WEIGHTS
-        digest = hashlib.sha256(weights_file.read_bytes()).hexdigest()
+        stat = weights_file.stat()
+        digest = file_sha256(weights_file, stat.st_size, stat.st_mtime_ns)
         if digest != self.base_sha256:
             raise ValueError(
                 f"the intent model was trained on encoder weights {self.base_sha256[:12]}..., "
