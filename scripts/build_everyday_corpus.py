@@ -45,6 +45,9 @@ import zipfile
 from collections import Counter
 from pathlib import Path
 
+from explaindrive.language.data import HELDOUT_CSV, data_path
+from explaindrive.language.intent.corpus import near_copies, read_lines
+
 DATA = Path(__file__).resolve().parents[1] / "src" / "explaindrive" / "language" / "data"
 TRAIN_FILE = "everyday_train.csv.gz"
 CHECK_FILE = "everyday_check.csv.gz"
@@ -179,6 +182,9 @@ def main(argv: list[str] | None = None) -> int:
     check = random.Random(0).sample(messages, CHECK_SIZE)
     overlap = {t.lower() for t in check} & seen
     rows = [r for r in rows if r[0].lower() not in overlap]  # the check stays unseen
+    tests = [row["text"] for row in read_lines(data_path(HELDOUT_CSV))]
+    near = near_copies(tests, [r[0] for r in rows])
+    rows = [r for r in rows if r[0] not in near]  # nothing near the test split is learned
 
     args.out.mkdir(parents=True, exist_ok=True)
     _write_gz(args.out / TRAIN_FILE, ["text", "source", "split"], rows)
@@ -186,7 +192,7 @@ def main(argv: list[str] | None = None) -> int:
     by_source = Counter((src, split) for _, src, split in rows)
     for (src, split), n in sorted(by_source.items()):
         print(f"{src:10s} {split:12s} {n:6d}")
-    print(f"dropped: {dict(dropped)}; removed as in the check: {len(overlap)}")
+    print(f"dropped: {dict(dropped)}; removed as in the check: {len(overlap)}, as near the test split: {len(near)}")
     print(f"check: {len(check)} of {len(messages)} chitchat messages")
     return 0
 

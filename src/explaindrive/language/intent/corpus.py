@@ -1,7 +1,8 @@
 """The lines LLM-1 learns from and is calibrated on, read from ``language/data``.
 
 * Requests (``commands_train.csv``): labelled passenger requests; its ``reserve`` split is
-  kept for calibration.
+  kept for calibration. The development split ``commands_heldout.csv`` (the previous test
+  split) is trained on whole.
 * Written lines (``commands_written.csv``): in-car chatter and phone talk that use pace and
   stopping words in other senses, questions about the car's behaviour (``why``), answers
   to a confirmation (``yes`` / ``no``), negated requests; one line in seven (by a hash of
@@ -12,7 +13,7 @@
 * The development splits ``commands_test.csv`` and ``commands_blind.csv`` are calibrated on,
   never trained on.
 
-The test split ``commands_heldout.csv`` and the external check ``everyday_check.csv.gz``
+The test split ``commands_heldout2.csv`` and the external check ``everyday_check.csv.gz``
 are read by the evaluation only.
 """
 
@@ -22,12 +23,15 @@ import csv
 import gzip
 import hashlib
 import io
+from collections.abc import Iterable
 from dataclasses import dataclass
+from difflib import SequenceMatcher
 from pathlib import Path
 
 from explaindrive.language.data import (
     BLIND_CSV,
     EVERYDAY_CHECK,
+    FIRST_HELDOUT_CSV,
     EVERYDAY_TRAIN,
     TEST_CSV,
     TRAIN_CSV,
@@ -38,6 +42,9 @@ from explaindrive.language.intent.model import READINGS
 
 DEVELOPMENT = (TEST_CSV, BLIND_CSV)
 RESERVE = "reserve"
+NEAR_COPY = 0.8
+"""Character similarity (difflib's ratio, either way round) from which a line counts as a
+near-copy of another: no line near the test split is trained or calibrated on."""
 WRITTEN_HOLDOUT = 7  # one written line in this many is kept for calibration
 
 
@@ -91,6 +98,7 @@ def _held_out(text: str) -> bool:
 def training_pool() -> tuple[list[Example], list[Example]]:
     """The labelled lines and the everyday lines (label ``none``) LLM-1 is trained on."""
     labelled = [e for e, row in _labelled(data_path(TRAIN_CSV)) if row.get("split") != RESERVE]
+    labelled += [e for e, _ in _labelled(data_path(FIRST_HELDOUT_CSV))]
     labelled += [e for e, _ in _labelled(data_path(WRITTEN_CSV)) if not _held_out(e.text)]
     everyday = [
         Example(row["text"], "none", f"{EVERYDAY_TRAIN}:{row['source']}")
@@ -120,3 +128,25 @@ def calibration_pool() -> list[Example]:
 def external_check() -> list[str]:
     """The external check's lines (everyday talk no model was trained or selected on)."""
     return [row["text"] for row in read_lines(data_path(EVERYDAY_CHECK))]
+
+
+def near_copies(tests: Iterable[str], seen: Iterable[str]) -> set[str]:
+    """The lines of ``seen`` that are near-copies of a line of ``tests`` (compared in lower
+    case; difflib's ratio, which is not symmetric, at least :data:`NEAR_COPY` either way
+    round). One matcher per second sequence, whose tables difflib caches, keeps this fast.
+    """
+    tests_l = sorted({t.lower() for t in tests})
+    seen_by = {}
+    for s in seen:
+        seen_by.setdefault(s.lower(), s)
+    near: set[str] = set()
+    for firsts, seconds, flip in ((tests_l, list(seen_by), False), (list(seen_by), tests_l, True)):
+        for b in seconds:
+            m = SequenceMatcher(None, "", b)
+            for a in firsts:
+                if 2 * min(len(a), len(b)) < NEAR_COPY * (len(a) + len(b)):
+                    continue  # real_quick_ratio from the lengths alone
+                m.set_seq1(a)
+                if m.quick_ratio() >= NEAR_COPY and m.ratio() >= NEAR_COPY:
+                    near.add(seen_by[a if flip else b])
+    return near
