@@ -24,8 +24,11 @@ LLM-1's negatives (split ``train``) and part of its calibration pool (``calibrat
 EVERYDAY_CHECK = "everyday_check.csv.gz"
 """The external check: chat messages of a public dialogue corpus no model is trained or
 selected on."""
-HELDOUT_CSV = "commands_heldout.csv"
+HELDOUT_CSV = "commands_heldout2.csv"
 """The test split: written and committed before any model was run on it, scored once."""
+FIRST_HELDOUT_CSV = "commands_heldout.csv"
+"""A development split: the previous test split (scored once, its errors read since),
+trained on."""
 TEST_CSV = "commands_test.csv"
 """A development split (scored as a test split once, read since): calibration only."""
 BLIND_CSV = "commands_blind.csv"

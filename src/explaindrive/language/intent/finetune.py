@@ -32,6 +32,7 @@ from explaindrive.language.intent.calibration import choose_thresholds
 from explaindrive.language.intent.corpus import Example, calibration_pool, training_pool
 from explaindrive.language.intent.encoders import minilm_model_dir
 from explaindrive.language.intent.model import READINGS, IntentModel, Thresholds
+from explaindrive.language.intent.noise import slipped
 from explaindrive.language.packaged import MINILM
 
 log = logging.getLogger(__name__)
@@ -54,6 +55,8 @@ class FinetuneConfig:
         lr_adapter: learning rate of the adapters.
         lr_head: learning rate of the head.
         label_smoothing: cross-entropy label smoothing.
+        slip_share: share of the labelled lines seen with a typing or hearing slip
+            (:mod:`~explaindrive.language.intent.noise`).
         max_tokens: lines are cut at this many tokens while training.
         spec: the adapters' rank and scale.
         seed: seed of the draws, the order and the initial adapters.
@@ -62,11 +65,12 @@ class FinetuneConfig:
 
     epochs: int = 5
     labelled_repeats: int = 2
-    everyday_per_epoch: int = 6000
+    everyday_per_epoch: int = 10000
     batch_size: int = 32
     lr_adapter: float = 5e-4
     lr_head: float = 3e-3
-    label_smoothing: float = 0.05
+    label_smoothing: float = 0.0
+    slip_share: float = 0.25
     max_tokens: int = 48
     spec: AdapterSpec = field(default_factory=AdapterSpec)
     seed: int = 0
@@ -146,7 +150,11 @@ def _epoch_lines(
 ) -> list[Example]:
     rng = random.Random(cfg.seed * 1000 + epoch)
     drawn = rng.sample(everyday, min(cfg.everyday_per_epoch, len(everyday)))
-    lines = labelled * cfg.labelled_repeats + drawn
+    seen = [
+        dataclasses.replace(e, text=slipped(e.text, rng)) if rng.random() < cfg.slip_share else e
+        for e in labelled * cfg.labelled_repeats
+    ]
+    lines = seen + drawn
     rng.shuffle(lines)
     return lines
 
