@@ -136,8 +136,11 @@ def test_training_splits_keep_file_order_and_number_the_dev_splits(tmp_path) -> 
 
 def test_decision_set() -> None:
     rows = load_decisions(data_path(DECISIONS_JSONL))
-    assert len(rows) >= 110
-    assert 60 <= sum(r.explain for r in rows) <= 80
+    assert len(rows) == 135
+    assert sum(r.explain for r in rows) == 82
+    with_history = [r for r in rows if r.history is not None]
+    assert len(with_history) == 19  # what a passenger notices over several steps
+    assert sum(r.explain for r in with_history) == 9
     several = [r for r in rows if r.explain and len(present_factors(r.record().nearby())) >= 3]
     assert len(several) >= 30  # the speed limit and at least two objects
 

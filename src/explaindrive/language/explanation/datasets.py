@@ -29,7 +29,9 @@ class LabelledRecord(StateRecord):
 
     def record(self) -> StateRecord:
         """The unlabelled record (what the modules see)."""
-        return StateRecord(request=self.request, action=self.action, state=self.state)
+        return StateRecord(
+            request=self.request, action=self.action, state=self.state, history=self.history
+        )
 
 
 def load_decisions(path: str | Path) -> list[LabelledRecord]:

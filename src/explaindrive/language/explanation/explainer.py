@@ -195,6 +195,11 @@ _CLOSERS: dict[Factor, tuple[str, ...]] = {
 }
 
 
+def _phrasing_key(record: StateRecord) -> str:
+    """What picks a record's phrasing: its step, not its history."""
+    return record.model_dump_json(exclude={"history"})
+
+
 def _pick(options: tuple[str, ...], key: str) -> str:
     digest = hashlib.blake2b(key.encode(), digest_size=4).digest()
     return options[int.from_bytes(digest, "big") % len(options)]
@@ -223,7 +228,7 @@ def opener_kind(record: StateRecord) -> str:
 def neutral_explanation(record: StateRecord) -> str:
     """A sentence true of the motion that names no factor, for a state with nothing to name."""
     kind = opener_kind(record)
-    opener = _pick(_OPENERS[kind], record.model_dump_json() + "o")
+    opener = _pick(_OPENERS[kind], _phrasing_key(record) + "o")
     if kind == "accelerate":
         return f"{opener}, it was the safer choice here."
     return f"{opener}, it is the safe choice here."
@@ -252,7 +257,7 @@ def template_explanation(
         "d_lead": f"{s.d_lead:.0f}" if s.d_lead is not None else "",
         "v_lim_kmh": f"{round(s.v_lim * 3.6)}",
     }
-    key = record.model_dump_json()
+    key = _phrasing_key(record)
     kind = opener_kind(record)
     opener = _pick(_OPENERS[kind], key + "o")
     if kind == "accelerate":  # only a yellow light too close to stop at explains it

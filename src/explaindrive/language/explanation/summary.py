@@ -4,9 +4,12 @@ A :class:`StateRecord` is the JSON shape the decision and explanation modules re
 
     {"request": "fast", "action": -2,
      "state": {"v_ego": 8.0, "v_lim": 13.9, "d_lead": 22.0, "dv": 1.5,
-               "d_tl": 35.0, "tl_state": "red", "d_cross": null}}
+               "d_tl": 35.0, "tl_state": "red", "d_cross": null},
+     "history": {"slow_s": 6.0, "stopped_s": 0.0, "drop_mps": 2.0}}
 
-``null`` means nothing within sensor range. The summary and the decision ignore
+``null`` means nothing within sensor range. ``history`` (optional) is what the passenger
+has felt up to the step (:mod:`~explaindrive.language.explanation.history`); a ride fills
+it, a record of a single step leaves it out. The summary and the decision ignore
 objects farther than a cut-off (50 m in the paper), see :meth:`StateRecord.nearby`.
 """
 
@@ -31,6 +34,7 @@ from explaindrive.language.explanation.hazards import (
     stopping_distance_m,
     ttc_s,
 )
+from explaindrive.language.explanation.history import RideHistory
 from explaindrive.validation import describe_errors
 
 _M = TypeVar("_M", bound=BaseModel)
@@ -98,6 +102,7 @@ class StateRecord(BaseModel):
     request: RequestLabel
     action: int = Field(ge=-3, le=3)  # [m/s] speed change of this step
     state: RecordState
+    history: RideHistory | None = None
 
     @property
     def command(self) -> Command:
@@ -109,7 +114,12 @@ class StateRecord(BaseModel):
         return self.state.within(cutoff_m)
 
     @classmethod
-    def from_observation(cls, obs: NDArray[np.floating], action_change_mps: int) -> StateRecord:
+    def from_observation(
+        cls,
+        obs: NDArray[np.floating],
+        action_change_mps: int,
+        history: RideHistory | None = None,
+    ) -> StateRecord:
         """Build a record from the env's raw (not normalised) 8-dim observation.
 
         Distances at or beyond ``SENSOR_RANGE_M`` become ``None``. A leader that sits
@@ -119,6 +129,7 @@ class StateRecord(BaseModel):
         Args:
             obs: observation in ``explaindrive.env.state.STATE_NAMES`` order.
             action_change_mps: the speed change chosen for this step, -3..3 [m/s].
+            history: what the passenger has felt up to this step, if a ride keeps it.
 
         Raises:
             ValueError: on a wrong shape or an out-of-range value.
@@ -147,6 +158,7 @@ class StateRecord(BaseModel):
                     tl_state=colour.label if colour is not None else None,  # type: ignore[arg-type]
                     d_cross=round(s.d_cross, 1) if cross else None,
                 ),
+                history=history,
             )
         except ValidationError as exc:
             raise ValueError(f"observation does not make a valid state record: {exc}") from exc
