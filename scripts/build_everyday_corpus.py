@@ -192,7 +192,8 @@ def main(argv: list[str] | None = None) -> int:
     by_source = Counter((src, split) for _, src, split in rows)
     for (src, split), n in sorted(by_source.items()):
         print(f"{src:10s} {split:12s} {n:6d}")
-    print(f"dropped: {dict(dropped)}; removed as in the check: {len(overlap)}, as near the test split: {len(near)}")
+    print(f"dropped: {dict(dropped)}; removed as in the check: {len(overlap)}", end="")
+    print(f", as near the test split: {len(near)}")
     print(f"check: {len(check)} of {len(messages)} chitchat messages")
     return 0
 

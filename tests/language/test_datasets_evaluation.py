@@ -66,8 +66,11 @@ def test_the_test_split_and_no_line_learned_or_calibrated_on_near_it() -> None:
     assert by_label == {"fast": 92, "comfort": 90, "stop": 86, "none": 222}
     negated = [r for r in heldout if r.kind == "negated_stop"]
     assert len(negated) == 38 and "stop" not in {r.label for r in negated}
-    seen = [r.text for name in (TRAIN_CSV, FIRST_HELDOUT_CSV, TEST_CSV, BLIND_CSV)
-            for r in load_commands(data_path(name))]
+    seen = [
+        r.text
+        for name in (TRAIN_CSV, FIRST_HELDOUT_CSV, TEST_CSV, BLIND_CSV)
+        for r in load_commands(data_path(name))
+    ]
     seen += [r["text"] for r in read_lines(data_path(WRITTEN_CSV))]
     assert near_copies([t.text for t in heldout], seen) == set()
 

@@ -2,8 +2,11 @@
 
 Both run in the lane's explanation channel, one task at a time. A step whose decision
 would wait behind a busy channel goes without one (a slow model must not build a queue of
-stale decisions), and an explanation for the same factor is repeated only after the
-ride's cool-down.
+stale decisions). Each step's record carries the ride's history (how long the car has been
+slow or standing, the speed it has just lost), so LLM-2 can explain what a passenger
+notices over several steps. A cause is explained once while it lasts (explain decisions
+naming it at most :data:`SAME_CAUSE_GAP_S` apart are one cause), and a factor explained
+before only after the ride's cool-down.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from explaindrive.language.explanation.decision import Decision, most_critical_factor
 from explaindrive.language.explanation.explainer import Explanation
+from explaindrive.language.explanation.history import HistoryTracker
 from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.jobs import DecideJob, ExplainJob
@@ -20,7 +24,12 @@ from explaindrive.ride.lane import EXPLANATION, LanguageLane, TaskKind
 from explaindrive.ride.records import RideCounts, StepRecord
 
 if TYPE_CHECKING:
+    from numpy.typing import NDArray
+
     from explaindrive.language.stack import LanguageStack
+
+SAME_CAUSE_GAP_S = 3.0
+"""[s] explain decisions naming one factor at most this far apart are about one cause."""
 
 
 class Explanations:
@@ -49,7 +58,16 @@ class Explanations:
         self.records = records
         self.latest: dict[str, Any] | None = None
         self._explained_at: dict[str | None, float] = {}  # factor -> when last explained
+        self._named_at: dict[str | None, float] = {}  # factor -> last explain decision naming it
         self._now: tuple[int, StateRecord] | None = None  # the newest step and its state
+        self.history = HistoryTracker()
+
+    def state_record(self, seen: NDArray[Any], change: int) -> StateRecord:
+        """The newest step's record for LLM-2 and LLM-3: what the driver saw (``seen``, the
+        raw observation), its speed change and the ride's history, updated by this step."""
+        record = StateRecord.from_observation(seen, change)
+        history = self.history.update(record.state.v_ego, record.state.v_lim)
+        return record.model_copy(update={"history": history})
 
     def submit_decision(self, record: StepRecord, state_record: StateRecord) -> None:
         """Ask LLM-2 about the newest step, unless the explanation channel is still busy."""
@@ -85,10 +103,15 @@ class Explanations:
         if not decision.explain:
             return
         self.counts.explain_decisions += 1
-        last_t = self._explained_at.get(factor, -math.inf)
-        if rec.t - last_t < self.config.explanation_cooldown_s:  # rate-limited per factor
+        named_t = self._named_at.get(factor, -math.inf)
+        self._named_at[factor] = rec.t
+        if rec.t - named_t <= SAME_CAUSE_GAP_S:  # the cause explained (or held back) lasts
             self.counts.suppressed_explanations += 1
-            rec.decision["suppressed"] = True
+            rec.decision["suppressed"] = "the same cause"
+            return
+        if rec.t - self._explained_at.get(factor, -math.inf) < self.config.explanation_cooldown_s:
+            self.counts.suppressed_explanations += 1
+            rec.decision["suppressed"] = "cool-down"
             return
         self._explained_at[factor] = rec.t
         self.lane.submit(

@@ -28,7 +28,6 @@ from explaindrive.env.metrics import EpisodeMetrics
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.language.explanation.decision import Decision
 from explaindrive.language.explanation.explainer import Explanation
-from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.ride.config import RideConfig
 from explaindrive.ride.events import EventType
 from explaindrive.ride.explaining import Explanations
@@ -213,8 +212,9 @@ class RideSession:
         self.records.append(record)
         self._obs = next_obs
         self.done = terminated or truncated
+        state_record = self.explanations.state_record(seen, change)
         if command is not Command.STOP or change > 0:
-            self.explanations.submit_decision(record, StateRecord.from_observation(seen, change))
+            self.explanations.submit_decision(record, state_record)
         if self.done:
             self._handle(self.lane.collect(wait=True))
             record.passenger.extend(self._inbox)

@@ -10,6 +10,7 @@ from explaindrive.language.backends.embedded import RuleDecider, TemplateExplain
 from explaindrive.language.explanation.decision import (
     Conflict,
     Factor,
+    holding_factors,
     parse_decision_tag,
     rule_decision,
 )
@@ -245,3 +246,66 @@ def test_firm_braking_behind_a_leader_under_fast(
         assert d.factor is Factor.LEAD_VEHICLE
         text = TemplateExplainer().explain(r, d.factor).text
         assert f"{d_lead:.0f} m" in text and reply_problems(text, r, d.factor) == []
+
+
+# --- what a passenger notices over several steps (the ride's history) ------------------------
+
+
+def hrec(request: str, action: int, history: dict[str, float], **state: Any) -> StateRecord:
+    base: dict[str, Any] = {"v_ego": 5.0, "v_lim": 13.9}
+    base.update(state)
+    return StateRecord.model_validate(
+        {"request": request, "action": action, "state": base, "history": history}
+    )
+
+
+def test_a_lasting_delay_behind_a_slower_car_is_explained_under_fast() -> None:
+    # 5 m/s behind a car at the same speed 30 m ahead: no hazard (headway 6 s), but the
+    # car has been 8.9 m/s under the limit for 8 s
+    d = rule_decision(hrec("fast", 0, {"slow_s": 8.0}, d_lead=30.0, dv=0.0))
+    assert d.explain and d.factor is Factor.LEAD_VEHICLE and d.conflict is Conflict.SLOWS
+    assert not rule_decision(hrec("fast", 0, {"slow_s": 4.0}, d_lead=30.0, dv=0.0)).explain
+    # the same step without its history explains nothing, as before
+    assert not rule_decision(rec("fast", 0, v_ego=5.0, d_lead=30.0, dv=0.0)).explain
+
+
+def test_a_felt_drop_is_explained_and_a_recovering_car_is_not() -> None:
+    # losing 3 m/s in 3 s behind a leader doing 9 - 1 = 8 m/s <= 13.9 - 3
+    d = rule_decision(hrec("fast", -1, {"drop_mps": 3.0}, v_ego=9.0, d_lead=45.0, dv=1.0))
+    assert d.explain and d.factor is Factor.LEAD_VEHICLE
+    small = hrec("fast", -1, {"drop_mps": 2.9}, v_ego=9.0, d_lead=45.0, dv=1.0)
+    assert not rule_decision(small).explain
+    assert not rule_decision(hrec("fast", 1, {"slow_s": 9.0}, d_lead=30.0, dv=-1.0)).explain
+
+
+def test_a_leader_near_the_limit_holds_no_one_back() -> None:
+    # leader at 10 - (-1) = 11 m/s > 13.9 - 3 = 10.9: not slower than the road allows
+    s = hrec("fast", 0, {"slow_s": 9.0}, v_ego=10.0, d_lead=40.0, dv=-1.0)
+    assert holding_factors(s.nearby()) == []
+    assert not rule_decision(s).explain
+
+
+def test_a_lasting_standstill_under_comfort_names_the_nearest_cause() -> None:
+    light = {"d_tl": 30.0, "tl_state": "red"}
+    queue = hrec("comfort", 0, {"stopped_s": 9.0}, v_ego=0.0, d_lead=6.0, dv=0.0, **light)
+    d = rule_decision(queue)
+    assert d.explain and d.conflict is Conflict.WAITS and d.factor is Factor.LEAD_VEHICLE
+    d = rule_decision(hrec("comfort", 0, {"stopped_s": 9.0}, v_ego=0.0, d_cross=6.0, **light))
+    assert d.factor is Factor.PEDESTRIAN
+    assert not rule_decision(hrec("comfort", 0, {"stopped_s": 4.0}, v_ego=0.0, **light)).explain
+    assert not rule_decision(hrec("stop", 0, {"stopped_s": 20.0}, v_ego=0.0, **light)).explain
+    assert not rule_decision(hrec("comfort", 0, {"stopped_s": 20.0}, v_ego=0.0)).explain
+
+
+def test_the_delay_explanation_names_the_slower_car_and_what_the_car_does() -> None:
+    r = hrec("fast", 0, {"slow_s": 8.0}, d_lead=30.0, dv=0.0)
+    text = template_explanation(r, Factor.LEAD_VEHICLE)
+    assert text == (
+        "We're holding 18 km/h behind the slower car ahead, 30 m away, which is doing 18 km/h. "
+        "I'll speed up when it clears."
+    )
+    assert check_grounding(text, Factor.LEAD_VEHICLE, r).ok
+    queue = hrec("comfort", 0, {"stopped_s": 7.0}, v_ego=0.0, d_lead=4.0, dv=0.0)
+    assert template_explanation(queue, Factor.LEAD_VEHICLE) == (
+        "We're waiting behind the stopped car ahead, 4 m away. We'll move on as soon as it does."
+    )

@@ -24,7 +24,7 @@ from explaindrive.language.intent.interpreter import (
     REPHRASE_MESSAGE,
     IntentInterpreter,
     IntentResult,
-    format_confirmation,
+    reply_to,
 )
 from explaindrive.language.intent.model import Reading
 from explaindrive.language.intent.reader import LineReader
@@ -74,7 +74,7 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
             )
         (reading,) = self.reader.read([text])
         intent = Command.parse(reading.command) if reading.command is not None else None
-        confirmation = format_confirmation(intent) if intent is not None else REPHRASE_MESSAGE
+        confirmation = reply_to(intent, reading.reading)
         log.debug("embedded reading %s for %r (%s)", reading.reading, text, reading.scores())
         return IntentResult(
             intent,

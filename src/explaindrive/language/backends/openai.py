@@ -50,12 +50,7 @@ from explaindrive.language.explanation.summary import (
     environment_summary,
 )
 from explaindrive.language.intent.agreement import reconcile
-from explaindrive.language.intent.interpreter import (
-    REPHRASE_MESSAGE,
-    IntentInterpreter,
-    IntentResult,
-    format_confirmation,
-)
+from explaindrive.language.intent.interpreter import IntentInterpreter, IntentResult, reply_to
 from explaindrive.language.intent.model import ANSWERS
 from explaindrive.redact import redact
 
@@ -257,7 +252,7 @@ class OpenAIIntentInterpreter(IntentInterpreter):
         own = verdict.source == "embedded"
         return IntentResult(
             verdict.intent,
-            format_confirmation(verdict.intent) if verdict.intent is not None else REPHRASE_MESSAGE,
+            reply_to(verdict.intent, _reading(verdict.intent, local.reading)),
             NAME,
             False,
             time.perf_counter() - t0,

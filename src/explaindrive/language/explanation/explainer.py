@@ -7,7 +7,12 @@ import re
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
-from explaindrive.language.explanation.decision import Factor
+from explaindrive.language.explanation.decision import (
+    Factor,
+    lasting_standstill,
+    noticed_delay,
+)
+from explaindrive.language.explanation.history import SLOW_MARGIN_MPS
 from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M, RecordState, StateRecord
 
 # Words that name each factor; used to check that a text is grounded in the state.
@@ -225,6 +230,29 @@ def opener_kind(record: StateRecord) -> str:
     return "hold"
 
 
+def _following(record: StateRecord, s: RecordState) -> str | None:
+    """What a passenger notices behind a slower or stopped car, in words, when the ride's
+    history shows it (a lasting delay, a felt drop, a lasting standstill); else ``None``."""
+    if s.d_lead is None or not (noticed_delay(record) or lasting_standstill(record)):
+        return None
+    v_lead = max(s.v_ego - (s.dv or 0.0), 0.0)
+    if opener_kind(record) == "wait" and v_lead <= SEEN_STANDSTILL_MPS:
+        return (
+            f"We're waiting behind the stopped car ahead, {s.d_lead:.0f} m away. "
+            "We'll move on as soon as it does."
+        )
+    car = "the slower car ahead" if v_lead <= s.v_lim - SLOW_MARGIN_MPS else "the car ahead"
+    doing = (
+        f"We're holding {round(s.v_ego * 3.6)} km/h behind"
+        if record.action == 0
+        else "I'm easing off behind"
+    )
+    return (
+        f"{doing} {car}, {s.d_lead:.0f} m away, which is doing {round(v_lead * 3.6)} km/h. "
+        "I'll speed up when it clears."
+    )
+
+
 def neutral_explanation(record: StateRecord) -> str:
     """A sentence true of the motion that names no factor, for a state with nothing to name."""
     kind = opener_kind(record)
@@ -266,6 +294,8 @@ def template_explanation(
                 f"accelerating by {record.action} m/s cannot be explained by {factor.value}"
             )
         return f"{opener}: {_ACCEL_REASON.format(**values)}. Everything is under control."
+    if factor is Factor.LEAD_VEHICLE and (following := _following(record, s)) is not None:
+        return following
     reason = _pick(_REASONS[factor], key + "r").format(**values)
     closer = _pick(_CLOSERS[factor], key + "c")
     if record.request == "comfort" and record.action <= -2:

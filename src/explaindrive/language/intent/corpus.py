@@ -31,8 +31,8 @@ from pathlib import Path
 from explaindrive.language.data import (
     BLIND_CSV,
     EVERYDAY_CHECK,
-    FIRST_HELDOUT_CSV,
     EVERYDAY_TRAIN,
+    FIRST_HELDOUT_CSV,
     TEST_CSV,
     TRAIN_CSV,
     WRITTEN_CSV,

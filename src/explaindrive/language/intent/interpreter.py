@@ -22,6 +22,8 @@ REPHRASE_MESSAGE = (
     "Sorry, I can only change how I drive: faster, more carefully, or stop. "
     "Could you rephrase your request?"
 )
+WHY_MESSAGE = "Let me explain what I'm doing."
+"""The reply to a question about the car's behaviour (reading ``why``)."""
 
 _CONFIRMATION_RE = re.compile(
     r"You want me to (drive faster|drive more carefully|stop), is this correct\?"
@@ -98,6 +100,14 @@ class IntentInterpreter(ABC):
 def format_confirmation(command: Command) -> str:
     """The paper's confirmation question for ``command``."""
     return CONFIRMATION_TEMPLATE.format(action=ACTION_PHRASES[command])
+
+
+def reply_to(command: Command | None, reading: str | None) -> str:
+    """What the car says to a line: the confirmation question for a command, a promise to
+    explain for a question about its behaviour, else a request to rephrase."""
+    if command is not None:
+        return format_confirmation(command)
+    return WHY_MESSAGE if reading == "why" else REPHRASE_MESSAGE
 
 
 def parse_confirmation(text: str) -> Command | None:

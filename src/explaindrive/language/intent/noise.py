@@ -64,7 +64,9 @@ def heard(text: str, rng: random.Random) -> str:
         return plain
     i = rng.choice(long)
     w = words[i]
-    swaps = [(a, b) for a, b in VOWEL_SOUNDS if a in w] + [(b, a) for a, b in VOWEL_SOUNDS if b in w]
+    swaps = [(a, b) for a, b in VOWEL_SOUNDS if a in w] + [
+        (b, a) for a, b in VOWEL_SOUNDS if b in w
+    ]
     if swaps and rng.random() < 0.5:
         a, b = rng.choice(swaps)
         words[i] = w.replace(a, b, 1)

@@ -140,7 +140,7 @@ function renderGauges() {
 // explain for a "why?", the answer for a yes or no.
 function describeReading(e) {
   if (e.intent) return `Car: ${e.confirmation}`;
-  if (e.reading === "why") return "Car: Let me explain what I'm doing.";
+  if (e.reading === "why") return `Car: ${e.confirmation}`;
   if (e.reading === "yes" || e.reading === "no") return `You answered ${e.reading}.`;
   return "Car: I did not understand that.";
 }
