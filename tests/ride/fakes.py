@@ -97,13 +97,14 @@ class KeywordInterpreter(IntentInterpreter):
 
 
 class BrakingDecider(ExplanationDecider):
-    """Explains every deceleration under fast, naming the traffic light."""
+    """Explains every deceleration under fast, naming the speed limit (a cause always
+    present, so no explanation of it comes too late)."""
 
     name = "fake"
 
     def decide(self, record: StateRecord) -> Decision:
         explain = record.request == "fast" and record.action < 0
-        factor = Factor.TRAFFIC_LIGHT if explain else None
+        factor = Factor.SPEED_LIMIT if explain else None
         conflict = Conflict.SLOWS if explain else Conflict.NONE
         return Decision(explain, factor, conflict, "test", self.name)
 

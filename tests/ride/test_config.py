@@ -84,7 +84,8 @@ def test_defaults_and_accepted_edges() -> None:
         backend="openai",
         traffic_level=MAX_TRAFFIC_LEVEL,
     )
-    assert (cfg.max_steps, cfg.interpret_deadline_s, cfg.backend) == (600, 2.0, "openai")
+    assert (cfg.max_steps, cfg.interpret_deadline_s, cfg.backend) == (600, 4.0, "openai")
+    assert (cfg.decide_deadline_s, cfg.explain_deadline_s) == (4.0, 0.0)
     assert (cfg.seed, cfg.explain_deadline_s, cfg.traffic_level) == (2**31 - 1, 0.0, 2.0)
     assert RideConfig(traffic_level=1).traffic_level == 1.0
     assert cfg.replace(seed=3) == RideConfig.from_dict({**cfg.to_dict(), "seed": 3})

@@ -49,4 +49,4 @@ def test_ride_help_shows_a_local_server_example() -> None:
     res = runner.invoke(app, ["ride", "--help"])
     text = " ".join(res.output.split())  # the help is wrapped to the terminal's width
     assert res.exit_code == 0 and "--model" in text
-    assert "'openai: {base_url: http://127.0.0.1:8080/v1, model: smollm2, timeout_s: 0.8}'" in text
+    assert "'openai: {base_url: http://127.0.0.1:8080/v1, model: smollm2, timeout_s: 3}'" in text

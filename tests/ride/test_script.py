@@ -31,10 +31,11 @@ def test_json_script_with_lines_key(tmp_path):
     assert (line.t, line.say, line.confirm, line.answer) == (5.0, "stop", "no", False)
 
 
-def test_default_script_exercises_fast_stop_comfort():
+def test_default_script_exercises_fast_why_stop_comfort():
     lines = load_script(default_script_path())
-    assert [ln.t for ln in lines] == [0.0, 60.0, 80.0]
-    assert all(ln.confirm == "yes" for ln in lines)
+    assert [ln.t for ln in lines] == [0.0, 52.0, 60.0, 80.0]
+    # a question is not confirmed
+    assert [ln.confirm for ln in lines] == ["yes", None, "yes", "yes"]
 
 
 @pytest.mark.parametrize(

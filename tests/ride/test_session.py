@@ -273,13 +273,15 @@ def test_a_slow_decider_skips_decisions_instead_of_queueing_them():
 
 def test_a_remote_deadline_must_leave_room_for_the_fallback():
     check_deadlines(RideConfig(), None)
-    check_deadlines(RideConfig(), 0.8)  # 0.8 + 0.2 fits the 1 s explanation deadline
-    with pytest.raises(ValueError, match=r"explain_deadline_s \(1 s\)"):
-        check_deadlines(RideConfig(), 0.81)
-    with pytest.raises(ValueError, match=r"interpret_deadline_s \(0\.5 s\)"):
-        check_deadlines(RideConfig(interpret_deadline_s=0.5, explain_deadline_s=2.0), 0.4)
+    check_deadlines(RideConfig(), 3.8)  # 3.8 + 0.2 fits the 4 s deadlines
+    with pytest.raises(ValueError, match=r"interpret_deadline_s \(4 s\)"):
+        check_deadlines(RideConfig(), 3.81)
+    with pytest.raises(ValueError, match=r"decide_deadline_s \(2 s\)"):
+        check_deadlines(RideConfig(decide_deadline_s=2.0), 1.9)
+    with pytest.raises(ValueError, match=r"explain_deadline_s \(0\.5 s\)"):
+        check_deadlines(RideConfig(explain_deadline_s=0.5), 0.4)
     with pytest.raises(ValueError, match=r"lower openai\.timeout_s"):
-        RideSession(RideConfig(), ScriptedController(), fake_language(remote_deadline_s=1.5))
+        RideSession(RideConfig(), ScriptedController(), fake_language(remote_deadline_s=3.9))
 
 
 @pytest.mark.parametrize("rule", ["always", "decided"])

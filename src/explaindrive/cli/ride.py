@@ -77,7 +77,7 @@ LanguageConfigOption = Annotated[
         "--config",
         help="YAML language config: backend, endpoint, model, key variable, timeouts. "
         "A local server: 'backend: openai' and 'openai: {base_url: "
-        "http://127.0.0.1:8080/v1, model: smollm2, timeout_s: 0.8}', then "
+        "http://127.0.0.1:8080/v1, model: smollm2, timeout_s: 3}', then "
         "explaindrive ride --config local.yaml (docs/language.md).",
     ),
 ]
@@ -357,10 +357,18 @@ def _print_summary(session: RideSession, outputs: RideOutputs) -> None:
         f"pedestrian-yield violations {m.ped_violations}, speeding steps {m.speeding_steps}"
     )
     console.print(
-        f"requests {c.requests}, confirmed {c.confirmations}, cancelled {c.cancellations}, "
-        f"explanations {c.explanations} (suppressed repeats {c.suppressed_explanations}), "
-        f"fallbacks {c.fallbacks}, late {c.late}"
+        f"requests {c.requests}, questions {c.questions}, confirmed {c.confirmations}, "
+        f"cancelled {c.cancellations}, explanations {c.explanations} "
+        f"(suppressed repeats {c.suppressed_explanations}), fallbacks {c.fallbacks}, "
+        f"late {c.late}"
     )
+    for name, label in (("interpret", "LLM-1"), ("decide", "LLM-2"), ("explain", "LLM-3")):
+        k = c.models[name]
+        stale = f", stale {k.stale}" if name == "explain" else ""
+        console.print(
+            f"{label} ({session.language.backend}): used {k.used}, fell back {k.fallback}, "
+            f"vetoed {k.vetoed}, late {k.late}{stale}"
+        )
     console.print(
         f"events:  {outputs.events}\nsummary: {outputs.summary}\nfigure:  {outputs.figure}"
     )

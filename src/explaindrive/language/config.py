@@ -80,10 +80,12 @@ class OpenAIConfig(LaxModel):
     servers without one). Prefer the variable: a config file is easily shared."""
     api_key_env: str = "OPENAI_API_KEY"
     """Environment variable read for the key when ``api_key`` is ``None``."""
-    timeout_s: float = Field(default=0.8, gt=0.0)
+    timeout_s: float = Field(default=3.0, gt=0.0)
     """[s] total deadline of one call: connecting, sending, reading and retries. When it
-    passes, the embedded module answers instead. A ride checks that it fits its own
-    deadlines (:data:`explaindrive.ride.session.FALLBACK_MARGIN_S`)."""
+    passes, the embedded module answers instead. The default lets a model that answers in
+    1-3 s (a small model served on a CPU, a cloud model on a slow day) be used; a ride
+    checks that it fits its own deadlines with the fallback's margin
+    (:data:`explaindrive.ride.session.FALLBACK_MARGIN_S`)."""
     max_retries: int = Field(default=0, ge=0)
     """Retries after a connection error, HTTP 429 or 5xx, within ``timeout_s``."""
     intent_temperature: float = Field(default=0.0, ge=0.0, le=2.0)

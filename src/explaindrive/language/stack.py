@@ -9,6 +9,7 @@ from explaindrive.language.backends import check_backend, get_backend
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.explanation.decision import ExplanationDecider
 from explaindrive.language.explanation.explainer import Explainer
+from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M
 from explaindrive.language.intent.interpreter import IntentInterpreter
 from explaindrive.language.speech.transcriber import SpeechToText, Transcriber
 
@@ -20,6 +21,7 @@ class LanguageStack:
     Attributes:
         remote_deadline_s: the total deadline of one call to a remote model [s], after
             which the embedded module answers; ``None`` when nothing remote is called.
+        cutoff_m: objects farther than this are left out of decisions and explanations [m].
     """
 
     backend: str
@@ -28,6 +30,7 @@ class LanguageStack:
     explainer: Explainer
     transcriber: SpeechToText
     remote_deadline_s: float | None = None
+    cutoff_m: float = SUMMARY_CUTOFF_M
 
     def load(self, speech: bool = False) -> LanguageStack:
         """Load the interpreter's model now (and Whisper's with ``speech``); returns self.
@@ -68,4 +71,5 @@ def make_language_stack(
         modules.explainer,
         Transcriber(cfg.speech),
         modules.remote_deadline_s,
+        cfg.embedded.cutoff_m,
     )

@@ -26,10 +26,20 @@ class RideConfig(ConfigModel, ScenarioFields):
         stop_without_confirm: apply a STOP request as soon as it is understood.
         explanation_cooldown_s: an explanation for the same reason is repeated only
             after this long [s]; a new reason is explained at once.
-        interpret_deadline_s: wall-time budget of interpreting a typed request [s].
+        interpret_deadline_s: wall-time budget of interpreting a typed request [s]: a
+            request that is not a STOP may wait this long for its confirmation question
+            (STOP is read offline first and keeps its bound).
         audio_deadline_s: wall-time budget of transcribing and interpreting a spoken
             request [s] (Whisper on a CPU needs about half the clip's length).
-        explain_deadline_s: wall-time budget of one decision or explanation [s].
+        decide_deadline_s: wall-time budget of one LLM-2 decision [s]. Decisions run
+            ahead of the driving loop: a step whose decision would wait behind a busy
+            model goes without one (the ride's history carries what it saw).
+        explain_deadline_s: wall-time budget of one LLM-3 explanation [s]; an explanation
+            that arrives after its step is shown if its cause is still present.
+
+        The three defaults (4 s) let a model that answers in 1-3 s be used: a remote
+        model's own deadline (``openai.timeout_s``, 3 s by default) plus the embedded
+        fallback's margin must fit each of them.
         realtime: pace the ride at one step per second.
         gui: show the ride in sumo-gui.
         fast_policy: the fast network ``explaindrive ride`` loads instead of the shipped
@@ -48,9 +58,10 @@ class RideConfig(ConfigModel, ScenarioFields):
     auto_confirm: bool = False
     stop_without_confirm: bool = False
     explanation_cooldown_s: Annotated[NonNegativeFloat, COOLDOWN_LIMIT] = 15.0  # <= 3,600
-    interpret_deadline_s: NonNegativeFloat = 2.0
+    interpret_deadline_s: NonNegativeFloat = 4.0
     audio_deadline_s: NonNegativeFloat = 8.0
-    explain_deadline_s: NonNegativeFloat = 1.0
+    decide_deadline_s: NonNegativeFloat = 4.0
+    explain_deadline_s: NonNegativeFloat = 4.0
     realtime: bool = False
     gui: bool = False
     fast_policy: TextPath | None = None

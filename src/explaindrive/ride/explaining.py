@@ -15,7 +15,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from explaindrive.language.explanation.decision import Decision, most_critical_factor
-from explaindrive.language.explanation.explainer import Explanation
+from explaindrive.language.explanation.explainer import Explanation, cause_present
 from explaindrive.language.explanation.history import HistoryTracker
 from explaindrive.language.explanation.summary import StateRecord
 from explaindrive.ride.config import RideConfig
@@ -80,7 +80,7 @@ class Explanations:
             TaskKind.DECIDE,
             self.language.decider.decide,
             state_record,
-            deadline_s=self.config.explain_deadline_s,
+            deadline_s=self.config.decide_deadline_s,
             context=DecideJob(state_record, len(self.records) - 1),
         )
 
@@ -100,6 +100,7 @@ class Explanations:
             rec.decision.update(vetoed=decision.vetoed, raw_reply=decision.raw_reply)
         rec.latency_s["decide"] = latency_s
         self.counts.fallbacks += int(decision.fallback)
+        self.counts.models["decide"].add(decision.fallback, decision.vetoed)
         if not decision.explain:
             return
         self.counts.explain_decisions += 1
@@ -136,14 +137,16 @@ class Explanations:
             TaskKind.EXPLAIN,
             self.language.explainer.explain,
             state_record,
-            most_critical_factor(state_record),
+            most_critical_factor(state_record, self.language.cutoff_m),
             deadline_s=self.config.explain_deadline_s,
             context=ExplainJob(step, question),
         )
         return True
 
     def on_explanation(self, job: ExplainJob, exp: Explanation, latency_s: float) -> None:
-        """Write LLM-3's explanation (its task took ``latency_s`` [s]) into its step's record."""
+        """Write LLM-3's explanation (its task took ``latency_s`` [s]) into the record of the
+        step it explains. One that arrives after a newer step is shown only if its cause is
+        still present in the newest state (a question's answer always is)."""
         rec = self.records[job.step]
         rec.explanation = {
             "text": exp.text,
@@ -153,10 +156,21 @@ class Explanations:
             "latency_s": round(latency_s, 4),
         }
         if exp.raw_reply is not None:
-            rec.explanation["raw_reply"] = exp.raw_reply
+            rec.explanation.update(raw_reply=exp.raw_reply, vetoed=exp.vetoed)
         if job.question is not None:
             rec.explanation["question"] = job.question
         rec.latency_s["explain"] = latency_s
-        self.counts.explanations += 1
         self.counts.fallbacks += int(exp.fallback)
+        module = self.counts.models["explain"]
+        module.add(exp.fallback, exp.vetoed)
+        newest = len(self.records) - 1
+        if newest > job.step:
+            rec.explanation["shown_t"] = self.records[newest].t
+            now = self._now[1] if self._now is not None else None
+            still = now is None or cause_present(now.nearby(self.language.cutoff_m), exp.factor)
+            if job.question is None and not still:
+                rec.explanation["shown"] = False  # its cause has gone: the passenger is spared
+                module.stale += 1
+                return
+        self.counts.explanations += 1
         self.latest = {"t": rec.t, **rec.explanation}

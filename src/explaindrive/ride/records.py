@@ -63,9 +63,43 @@ class StepRecord:
         }
 
 
+MODULES = ("interpret", "decide", "explain")
+"""The ride's language modules as counted: LLM-1, LLM-2, LLM-3."""
+
+
+@dataclass
+class ModuleCounts:
+    """What became of one language module's answers in a ride.
+
+    Attributes:
+        used: the configured backend's own answer was used.
+        fallback: the backend failed (an error, a timeout, an unreadable reply) and the
+            embedded module answered instead.
+        vetoed: the backend's reply was overruled by the embedded module or by the check
+            against the state.
+        late: the task passed the ride's deadline; its answer, if any, was dropped.
+        stale: (explanations) it arrived after its cause had gone and was not shown.
+    """
+
+    used: int = 0
+    fallback: int = 0
+    vetoed: int = 0
+    late: int = 0
+    stale: int = 0
+
+    def add(self, fallback: bool, vetoed: bool) -> None:
+        """Count one answer."""
+        if vetoed:
+            self.vetoed += 1
+        elif fallback:
+            self.fallback += 1
+        else:
+            self.used += 1
+
+
 @dataclass
 class RideCounts:
-    """Counters for the ride summary."""
+    """Counters for the ride summary (``models``: per language module)."""
 
     requests: int = 0
     answers: int = 0
@@ -82,3 +116,12 @@ class RideCounts:
     errors: int = 0
     superseded: int = 0
     skipped_decisions: int = 0
+    models: dict[str, ModuleCounts] = field(
+        default_factory=lambda: {m: ModuleCounts() for m in MODULES}
+    )
+
+    def to_json(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        out: dict[str, Any] = {k: v for k, v in self.__dict__.items() if k != "models"}
+        out["models"] = {m: c.__dict__.copy() for m, c in self.models.items()}
+        return out

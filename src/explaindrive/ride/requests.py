@@ -204,6 +204,7 @@ class PassengerRequests:
             )
             return
         self.counts.fallbacks += int(result.fallback)
+        self.counts.models["interpret"].add(result.fallback, result.overruled)
         self._note(
             {
                 "type": EventType.INTERPRETATION,

@@ -120,6 +120,17 @@ class RideSession:
         return self.lane.pending_kind(TaskKind.INTERPRET)
 
     @property
+    def thinking(self) -> list[str]:
+        """The language modules at work now (``interpret``, ``decide``, ``explain``)."""
+        kinds = {
+            TaskKind.TRANSCRIBE: "interpret",
+            TaskKind.INTERPRET: "interpret",
+            TaskKind.DECIDE: "decide",
+            TaskKind.EXPLAIN: "explain",
+        }
+        return sorted({m for k, m in kinds.items() if self.lane.pending_kind(k)})
+
+    @property
     def language(self) -> LanguageStack:
         """The language modules (replacing them reaches the requests and the explanations)."""
         return self.requests.language
@@ -252,6 +263,8 @@ class RideSession:
         kind = out.task.kind
         what = EventType.LATE if out.late else EventType.ERROR
         self.counts.late += out.late
+        module = "interpret" if kind is TaskKind.TRANSCRIBE else kind.value
+        self.counts.models[module].late += out.late
         self.counts.errors += out.error is not None
         self._note(
             {
@@ -275,7 +288,7 @@ class RideSession:
         return {
             "config": self.config.to_dict(),
             "metrics": res.as_dict(),
-            "counts": self.counts.__dict__.copy(),
+            "counts": self.counts.to_json(),
             "final_command": self.controller.command.label,
             "steps": len(self.records),
             "shield_replacements": sum(r.shield is not None for r in self.records),
@@ -291,7 +304,7 @@ def check_deadlines(config: RideConfig, remote_deadline_s: float | None) -> None
     """
     if remote_deadline_s is None:
         return
-    for name in ("interpret_deadline_s", "explain_deadline_s"):
+    for name in ("interpret_deadline_s", "decide_deadline_s", "explain_deadline_s"):
         ride_s = getattr(config, name)
         if remote_deadline_s + FALLBACK_MARGIN_S > ride_s:
             raise ValueError(

@@ -31,6 +31,8 @@ def step_frame(
         exp = session.records[index].explanation
         if exp is not None and index not in explained:
             explained.add(index)
+            if exp.get("shown") is False:  # came after its cause had gone
+                continue
             explanations.append(
                 {
                     "t": session.records[index].t,
@@ -54,6 +56,8 @@ def step_frame(
             "passenger": redact_json([public_event(e) for e in record.passenger]),
             "question": _redacted(pending.question) if pending is not None else None,
             "explanations": explanations,
+            "thinking": session.thinking,
+            "models": session.counts.to_json()["models"],
             "scene": snapshot(session.env.sumo, scene),
         }
     )

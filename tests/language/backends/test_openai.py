@@ -131,8 +131,8 @@ def test_untrue_explanations_fall_back_and_say_why(
     e = OpenAIExplainer(client(openai_server), TemplateExplainer()).explain(
         RED, Factor.TRAFFIC_LIGHT
     )
-    assert e.fallback and e.backend == "embedded"
-    assert (e.error or "").startswith("BackendReplyError: explanation rejected: ")
+    assert e.fallback and e.vetoed and e.backend == "embedded"
+    assert (e.error or "").startswith("explanation rejected: ")
     assert why in (e.error or "")
     assert "30 m" in e.text and "red" in e.text  # the template, true of the state
 

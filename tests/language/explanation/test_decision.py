@@ -309,3 +309,12 @@ def test_the_delay_explanation_names_the_slower_car_and_what_the_car_does() -> N
     assert template_explanation(queue, Factor.LEAD_VEHICLE) == (
         "We're waiting behind the stopped car ahead, 4 m away. We'll move on as soon as it does."
     )
+
+
+def test_a_cause_is_present_while_it_still_gives_a_reason() -> None:
+    from explaindrive.language.explanation.explainer import cause_present
+
+    s = rec("fast", 0, d_tl=20.0, tl_state="green", d_lead=15.0, dv=0.0).nearby()
+    assert not cause_present(s, Factor.TRAFFIC_LIGHT)  # green is no reason
+    assert cause_present(s, Factor.LEAD_VEHICLE) and cause_present(s, Factor.SPEED_LIMIT)
+    assert not cause_present(s, Factor.PEDESTRIAN) and cause_present(s, None)

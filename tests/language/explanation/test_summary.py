@@ -101,3 +101,19 @@ def test_summary_lists_the_hazard_that_forces_the_action_first() -> None:
         {"request": "fast", "action": 0, "state": {"v_ego": 0, "v_lim": 13.9}}
     )
     assert "Most urgent" not in environment_summary(standing)
+
+
+def test_history_summary_in_words() -> None:
+    from explaindrive.language.explanation.summary import history_summary
+
+    def with_history(**h: float) -> StateRecord:
+        return StateRecord.model_validate(
+            {"request": "fast", "action": 0, "state": {"v_ego": 5.0, "v_lim": 13.9}, "history": h}
+        )
+
+    # SLOW_MARGIN_MPS = 3 m/s = 10.8 -> 11 km/h
+    assert history_summary(with_history(slow_s=8.0, drop_mps=4.0)) == (
+        "8 s at least 11 km/h under the limit; 4.0 m/s of speed lost in the last 3 s."
+    )
+    assert history_summary(with_history(slow_s=9.0, stopped_s=6.0)) == "standing for 6 s."
+    assert history_summary(with_history()) == ""

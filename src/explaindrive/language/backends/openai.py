@@ -48,6 +48,7 @@ from explaindrive.language.explanation.summary import (
     StateRecord,
     describe_action,
     environment_summary,
+    history_summary,
 )
 from explaindrive.language.intent.agreement import reconcile
 from explaindrive.language.intent.interpreter import IntentInterpreter, IntentResult, reply_to
@@ -106,11 +107,14 @@ class BackendReplyError(RuntimeError):
 
 
 def situation_message(record: StateRecord, cutoff_m: float) -> str:
-    """The user message of LLM-2/LLM-3: request, action and environment summary."""
+    """The user message of LLM-2/LLM-3: request, action, environment summary and, from a
+    ride, what the passenger has felt so far (:func:`history_summary`)."""
+    felt = history_summary(record)
     return (
         f"Passenger request: {_REQUEST_TEXT[record.request]}\n"
         f"Vehicle action: {describe_action(record.action)}\n"
         f"Environment: {environment_summary(record, cutoff_m)}"
+        + (f"\nSo far: {felt}" if felt else "")
     )
 
 
@@ -363,7 +367,10 @@ class OpenAIExplainer(Explainer):
             text = passenger_text(raw)
             problems = reply_problems(text, record, factor, cutoff)
             if problems:
-                raise BackendReplyError(f"explanation rejected: {'; '.join(problems)}")
+                error = f"explanation rejected: {'; '.join(problems)}"
+                log.info("openai explanation vetoed, using templates: %s", error)
+                vetoed = _as_fallback(self.fallback.explain(record, factor), t0, error, raw)
+                return dataclasses.replace(vetoed, vetoed=True)
             return Explanation(
                 text, factor, NAME, latency_s=time.perf_counter() - t0, raw_reply=raw
             )

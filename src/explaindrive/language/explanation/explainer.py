@@ -45,6 +45,8 @@ class Explanation:
         error: why the configured backend was bypassed, when ``fallback``.
         raw_reply: the remote model's reply as it came (for the ride log only; the
             passenger sees ``text``).
+        vetoed: a remote reply came but failed the check against the state (``fallback``
+            too: the template stood in).
     """
 
     text: str
@@ -54,6 +56,7 @@ class Explanation:
     latency_s: float = 0.0
     error: str | None = None
     raw_reply: str | None = None
+    vetoed: bool = False
 
 
 class Explainer(ABC):
@@ -81,6 +84,19 @@ def present_factors(state: RecordState) -> set[Factor]:
     if state.d_lead is not None:
         found.add(Factor.LEAD_VEHICLE)
     return found
+
+
+def cause_present(state: RecordState, factor: Factor | None) -> bool:
+    """Whether ``factor`` still gives a reason in a (cut-off) state: a red or yellow light,
+    a pedestrian on the crossing, a vehicle ahead, the limit (always); ``None`` (a neutral
+    explanation): always."""
+    if factor is Factor.TRAFFIC_LIGHT:
+        return state.tl_state in ("red", "yellow")
+    if factor is Factor.PEDESTRIAN:
+        return state.d_cross is not None
+    if factor is Factor.LEAD_VEHICLE:
+        return state.d_lead is not None
+    return True
 
 
 @dataclass(frozen=True, slots=True)

@@ -34,7 +34,7 @@ from explaindrive.language.explanation.hazards import (
     stopping_distance_m,
     ttc_s,
 )
-from explaindrive.language.explanation.history import RideHistory
+from explaindrive.language.explanation.history import DROP_WINDOW_S, SLOW_MARGIN_MPS, RideHistory
 from explaindrive.validation import describe_errors
 
 _M = TypeVar("_M", bound=BaseModel)
@@ -251,6 +251,26 @@ def environment_summary(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M)
     if hazards:
         parts.append(f"Most urgent: {_urgency_phrase(s, hazards[0])}.")
     return " ".join(parts)
+
+
+def history_summary(record: StateRecord) -> str:
+    """What the passenger has felt up to the step, in words ("" without a history or with
+    nothing to tell): how long the car has been slow or standing, the speed it just lost.
+
+    Example:
+        ``8 s at least 11 km/h under the limit; 4.0 m/s of speed lost in the last 3 s.``
+    """
+    h = record.history
+    if h is None:
+        return ""
+    parts = []
+    if h.stopped_s > 0:
+        parts.append(f"standing for {h.stopped_s:.0f} s")
+    elif h.slow_s > 0:
+        parts.append(f"{h.slow_s:.0f} s at least {_kmh(SLOW_MARGIN_MPS)} km/h under the limit")
+    if h.drop_mps > 0:
+        parts.append(f"{h.drop_mps:.1f} m/s of speed lost in the last {DROP_WINDOW_S} s")
+    return "; ".join(parts) + "." if parts else ""
 
 
 def _lead_sentence(s: RecordState) -> str | None:

@@ -20,6 +20,7 @@ const ui = {
   sayForm: $("say-form"), sayInput: $("say-input"), record: $("record"),
   question: $("question"), questionBox: $("question-box"), yes: $("yes"), no: $("no"),
   message: $("message"), log: $("log"), explanations: $("explanations"),
+  thinking: $("thinking"), models: $("models"),
 };
 
 const view = {
@@ -90,9 +91,23 @@ function receive(msg) {
     if (msg.explanations.length) renderExplanations(false, msg.explanations);
     if (msg.passenger.length) renderLog(false, msg.passenger);
     setQuestion(msg.question);
+    setThinking(msg.thinking || [], msg.models);
   }
   renderGauges();
   draw();
+}
+
+// While a language model works the car shows it is thinking; the counts say, per module,
+// how often the model's own answer was used, fell back, was vetoed or came too late.
+const MODULE_NAMES = { interpret: "understanding", decide: "deciding", explain: "explaining" };
+function setThinking(modules, models) {
+  ui.thinking.hidden = modules.length === 0;
+  ui.thinking.textContent = modules.length
+    ? `thinking… (${modules.map((m) => MODULE_NAMES[m] || m).join(", ")})` : "";
+  if (!models) return;
+  ui.models.textContent = Object.entries(models).map(([m, c]) =>
+    `${MODULE_NAMES[m] || m}: used ${c.used}, fell back ${c.fallback}, vetoed ${c.vetoed}, late ${c.late}`
+  ).join(" · ");
 }
 
 function clearRide(ride) {
