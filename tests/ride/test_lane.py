@@ -77,3 +77,12 @@ def test_a_late_task_still_running_keeps_its_channel_busy(lane: LanguageLane) ->
 def test_unknown_task_kind_is_refused(lane: LanguageLane) -> None:
     with pytest.raises(ValueError, match="unknown language task 'summarise'"):
         lane.submit("summarise", print, deadline_s=1.0)
+
+
+def test_working_counts_running_tasks_not_finished_ones(lane: LanguageLane) -> None:
+    lane.submit("interpret", time.sleep, 0.3, deadline_s=2.0)
+    lane.submit("decide", lambda: None, deadline_s=2.0)
+    time.sleep(0.1)  # the decision is done, waiting to be collected; the line is not
+    assert lane.working() == {"interpret"} and lane.pending == 2
+    lane.collect(wait=True)
+    assert lane.working() == set()

@@ -112,6 +112,11 @@ class LanguageLane:
         """Whether a task of ``kind`` is pending."""
         return any(t.kind == kind for t in self._pending)
 
+    def working(self) -> set[TaskKind]:
+        """The kinds of task a worker is still running (finished ones waiting to be
+        collected are not counted)."""
+        return {t.kind for t in self._pending if not t.future.done()}
+
     def busy(self, channel: str) -> bool:
         """Whether ``channel`` has a task that is pending or still running after its deadline."""
         return any(t.channel == channel for t in self._pending) or any(

@@ -122,13 +122,13 @@ class RideSession:
     @property
     def thinking(self) -> list[str]:
         """The language modules at work now (``interpret``, ``decide``, ``explain``)."""
-        kinds = {
+        modules = {
             TaskKind.TRANSCRIBE: "interpret",
             TaskKind.INTERPRET: "interpret",
             TaskKind.DECIDE: "decide",
             TaskKind.EXPLAIN: "explain",
         }
-        return sorted({m for k, m in kinds.items() if self.lane.pending_kind(k)})
+        return sorted({modules[k] for k in self.lane.working()})
 
     @property
     def language(self) -> LanguageStack:

@@ -174,9 +174,13 @@ def _close(said_m: float, actual_m: float) -> bool:
 
 
 def _speed_problems(text: str, s: RecordState) -> list[str]:
-    known = (s.v_ego * 3.6, s.v_lim * 3.6)
+    """Speeds said that are none of the car's, the limit's or the leader's."""
+    known = [s.v_ego * 3.6, s.v_lim * 3.6]
+    if s.d_lead is not None:
+        known.append(max(s.v_ego - (s.dv or 0.0), 0.0) * 3.6)
+    have = ", ".join(f"{k:.0f}" for k in known)
     return [
-        f"gives a speed of {m.group(1)} km/h; the state has {known[0]:.0f} and {known[1]:.0f}"
+        f"gives a speed of {m.group(1)} km/h; the state has {have}"
         for m in _SPEED_KMH.finditer(text)
         if all(abs(float(m.group(1)) - k) > SPEED_TOLERANCE_KMH for k in known)
     ]
