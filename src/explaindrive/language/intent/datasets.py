@@ -13,10 +13,11 @@ LLM-1 does with a request: ``train`` and the former development splits ``dev-1``
 
 from __future__ import annotations
 
-import csv
 import re
 from dataclasses import dataclass
 from pathlib import Path
+
+from explaindrive.language.intent.corpus import read_lines
 
 INTENT_LABELS: tuple[str, ...] = ("fast", "comfort", "stop", "none")
 TRAIN_SPLIT = "train"
@@ -37,7 +38,8 @@ class CommandExample:
 
 
 def load_commands(path: str | Path) -> list[CommandExample]:
-    """Read a command CSV.
+    """Read a command CSV (plain or gzip-compressed, by
+    :func:`~explaindrive.language.intent.corpus.read_lines`).
 
     Raises:
         FileNotFoundError: if the file is missing.
@@ -45,31 +47,24 @@ def load_commands(path: str | Path) -> list[CommandExample]:
             number).
     """
     p = Path(path)
-    if not p.is_file():
-        raise FileNotFoundError(f"command file not found: {p}")
-    with p.open(newline="", encoding="utf-8") as fh:
-        reader = csv.DictReader(fh)
-        if reader.fieldnames is None or not {"text", "label"} <= set(reader.fieldnames):
-            raise ValueError(f"{p}: expected a CSV header with columns text,label[,kind][,split]")
-        out: list[CommandExample] = []
-        for line, row in enumerate(reader, start=2):
-            text = (row.get("text") or "").strip()
-            label = (row.get("label") or "").strip().lower()
-            if not text:
-                raise ValueError(f"{p}:{line}: empty text")
-            if label not in INTENT_LABELS:
-                raise ValueError(
-                    f"{p}:{line}: unknown label {label!r}; expected one of {INTENT_LABELS}"
-                )
-            split = (row.get("split") or "").strip()
-            if "split" in reader.fieldnames and not _SPLIT.fullmatch(split):
-                raise ValueError(
-                    f"{p}:{line}: unknown split {split!r}; expected {TRAIN_SPLIT}, "
-                    f"{DEV_PREFIX}<k> or {RESERVE_SPLIT}"
-                )
-            out.append(CommandExample(text, label, (row.get("kind") or "").strip(), split))
-    if not out:
-        raise ValueError(f"{p}: no rows")
+    rows = read_lines(p)
+    columns = set(rows[0]) if rows else set()
+    if not rows or not {"text", "label"} <= columns:
+        raise ValueError(f"{p}: expected a CSV header with columns text,label[,kind][,split]")
+    out: list[CommandExample] = []
+    for line, row in enumerate(rows, start=2):
+        label = row.get("label", "").lower()
+        if label not in INTENT_LABELS:
+            raise ValueError(
+                f"{p}:{line}: unknown label {label!r}; expected one of {INTENT_LABELS}"
+            )
+        split = row.get("split", "")
+        if "split" in columns and not _SPLIT.fullmatch(split):
+            raise ValueError(
+                f"{p}:{line}: unknown split {split!r}; expected {TRAIN_SPLIT}, "
+                f"{DEV_PREFIX}<k> or {RESERVE_SPLIT}"
+            )
+        out.append(CommandExample(row["text"], label, row.get("kind", ""), split))
     return out
 
 
