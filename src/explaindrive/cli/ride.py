@@ -86,6 +86,14 @@ ModelOption = Annotated[
     typer.Option("--model", help="Model name for the openai backend (replaces --config's)."),
 ]
 CooldownOption = Annotated[float, typer.Option("--cooldown", help="Explanation cool-down [s].")]
+DeadlinesOption = Annotated[
+    str | None,
+    typer.Option(
+        "--deadlines",
+        help="Wall-time budgets of LLM-1, LLM-2 and LLM-3 [s], INTERPRET,DECIDE,EXPLAIN "
+        "(default: 4,4,4; a remote model's openai.timeout_s + 0.2 must fit each).",
+    ),
+]
 # The simulation
 TrafficOption = Annotated[float, typer.Option("--traffic", help="Traffic level (1.0 = 900 veh/h).")]
 SeedOption = Annotated[int, typer.Option("--seed", min=0, max=MAX_SEED, help="Simulation seed.")]
@@ -119,6 +127,7 @@ def ride(
     stop_without_confirm: StopWithoutConfirmOption = DEFAULTS.stop_without_confirm,
     max_steps: MaxStepsOption = DEFAULTS.max_steps,
     cooldown: CooldownOption = DEFAULTS.explanation_cooldown_s,
+    deadlines: DeadlinesOption = None,
     live: LiveOption = True,
     fast_policy: FastPolicyOption = None,
     comfort_policy: ComfortPolicyOption = None,
@@ -151,6 +160,7 @@ def ride(
             fast_policy=fast_policy,
             comfort_policy=comfort_policy,
             obs_noise=obs_noise_sd(obs_noise),
+            **module_deadlines(deadlines),
             **where.scenario_fields(scenario, net, route, demand),
         )
         lines = _script_lines(script, interactive, max_steps)
@@ -162,6 +172,25 @@ def ride(
     if script is None and not interactive:
         console.print(f"default ride script: {default_script_path()}")
     _drive_and_report(session, lines, staging, out, typed, live)
+
+
+def module_deadlines(text: str | None) -> dict[str, float]:
+    """``--deadlines INTERPRET,DECIDE,EXPLAIN`` as ``RideConfig`` fields ({} when not given).
+
+    Raises:
+        ValueError: unless it is three numbers separated by commas.
+    """
+    if text is None:
+        return {}
+    parts = text.split(",")
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        values = []
+    if len(values) != 3:
+        raise ValueError(f"--deadlines takes INTERPRET,DECIDE,EXPLAIN in s, got {text!r}")
+    names = ("interpret_deadline_s", "decide_deadline_s", "explain_deadline_s")
+    return dict(zip(names, values, strict=True))
 
 
 def _drive_and_report(
