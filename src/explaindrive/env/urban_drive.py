@@ -180,7 +180,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise
         self._entry = entry
         leaders = LeaderSensor(entry.min_gap_m, self._leader_lengths)
-        perception = Perception(self.geometry, self._crossing_lanes, leaders)
+        perception = Perception(self.geometry, self._crossing_lanes, leaders, entry.length_m)
         self._ep = ep = Episode(
             command=opts.command,
             schedule=list(opts.command_schedule),
