@@ -4,6 +4,11 @@ Each step is 1 s. The action changes the ego speed by -3..+3 m/s; SUMO's own
 safety checks for the ego are off (speed mode 0), so collisions, red-light runs,
 pedestrian-yield and speed-limit violations can happen and are counted.
 
+In the ``passenger`` preset the speed limiter is on (``speed_limiter``,
+:func:`~explaindrive.env.actions.limited_speed`): a rise that would pass the posted limit
+lands on it. ``change`` in the step's record stays the action's; the acceleration is the
+speed's true change.
+
 The environment composes small parts: :mod:`~explaindrive.env.sumo_process` (SUMO, the
 warm-up, the ego's entry), :mod:`~explaindrive.env.perception` (the observation) and
 :mod:`~explaindrive.env.violations` (what the ego did wrong).
@@ -27,6 +32,7 @@ from explaindrive.env.actions import (
     N_ACTIONS,
     STEP_LENGTH_S,
     least_stopping_need,
+    limited_speed,
     speed_change,
     stopping_need,
 )
@@ -144,8 +150,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     def action_masks(self) -> NDArray[np.bool_]:
         """The actions the run-time shield allows in the current true state (a copy, shape
         ``(7,)``): :func:`~explaindrive.env.safety.runtime_mask` of the raw observation
-        without sensor noise, with the active command."""
-        return runtime_mask(self._last_obs)
+        without sensor noise, with the active command (through the speed limiter when it is
+        on)."""
+        return runtime_mask(self._last_obs, self.config.speed_limiter)
 
     @property
     def _ego_length_m(self) -> float:
@@ -223,7 +230,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise RuntimeError("the episode is over; call reset() before step()")
         change = speed_change(action)
         cmd, prev_obs, prev_pos, seen = ep.command, self._last_obs, ep.pos_m, ep.seen
-        motion = self._advance(ep, change)
+        motion = self._advance(ep, change, float(prev_obs[S.V_LIM]))
         if self.config.ego_model != "agent":
             change = round(motion.speed_mps - ep.speed_mps)
         accel = motion.speed_mps - ep.speed_mps
@@ -290,9 +297,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         """The step limit cut a non-terminal episode."""
         return not terminated and self._episode().steps >= self.config.max_steps
 
-    def _advance(self, ep: Episode, change: int) -> Motion:
-        """Set the ego's speed (or let SUMO drive it), simulate one step, read the outcome."""
-        v_new = max(0.0, ep.speed_mps + change)
+    def _advance(self, ep: Episode, change: int, posted_limit_mps: float) -> Motion:
+        """Set the ego's speed (or let SUMO drive it), simulate one step, read the outcome.
+        With the speed limiter on, a rise that would pass ``posted_limit_mps`` (the limit the
+        agent observed) lands on it."""
+        limit = posted_limit_mps if self.config.speed_limiter else None
+        v_new = limited_speed(ep.speed_mps, change, limit)
         agent = self.config.ego_model == "agent"
         # a baseline: SUMO drives; STOP asks it to brake to a standstill within its decel limit
         sumo_speed = 0.0 if ep.command is Command.STOP else SUMO_DRIVES
