@@ -20,7 +20,7 @@ from explaindrive.env.right_of_way import (
     arrival_time_s,
     clear_time_s,
     junction_of,
-    link_has_priority,
+    link_yields,
     must_yield,
 )
 from explaindrive.env.urban_drive import UrbanDriveEnv
@@ -83,7 +83,8 @@ def test_a_foe_arrives_as_early_as_its_acceleration_allows() -> None:
 
 
 def test_link_states_and_junction_ids() -> None:
-    assert [link_has_priority(c) for c in "GMOgmsw=Z"] == [True] * 3 + [False] * 6
+    # priority, then open but yielding, then the light's to judge (red, red-yellow, yellow)
+    assert [link_yields(c) for c in "GMOgmsw=oZruy"] == [False] * 3 + [True] * 7 + [False] * 3
     assert junction_of(":J_7_0") == "J"
     assert junction_of(":cluster_J1_J2_12_0") == "cluster_J1_J2"
     assert junction_of("SJ_0") == ""
@@ -133,11 +134,13 @@ def _drive(env: UrbanDriveEnv, foe_at_step: int, steps: int = 70) -> list[dict[s
         foe_road = api.vehicle.getRoadID("foe") if "foe" in api.vehicle.getIDList() else ""
         rows.append({"pos": env.route_pos_m, "v": float(obs[S.V_EGO]),
                      "lead": float(obs[S.D_LEAD]), "dv": float(obs[S.DV]),
-                     "yield": seen.yield_gap_m, "foe_on_je": foe_road == "JE",
-                     "foe_gone": foe_road in ("JE", "")})  # fmt: skip
+                     "yield": seen.yields.leader_gap_m, "foe_on_je": foe_road == "JE",
+                     "foe_gone": foe_road in ("JE", ""),
+                     "yield_violation": False})  # fmt: skip
         decision = shield(obs, np.arange(7, dtype=np.float64))  # the fastest safe change
         obs, _r, terminated, truncated, info = env.step(decision.action)
         assert not info["collision"]
+        rows[-1]["yield_violation"] = info["yield_violation"]
         if terminated or truncated:
             break
     assert info["arrived"]
@@ -166,6 +169,33 @@ def test_a_yield_line_holds_the_ego_while_a_foe_with_priority_approaches(
     assert min(LINE_M - r["pos"] for r in rows if r["pos"] <= LINE_M) > 0.0
     # once the foe has passed, the line is no leader
     assert all(r["yield"] == S.SENSOR_RANGE_M for r in rows if r["foe_gone"])
+    assert not any(r["yield_violation"] for r in rows)
+
+
+@pytest.mark.slow
+def test_entering_in_front_of_the_foe_is_a_yield_violation(
+    make_env: Callable[..., UrbanDriveEnv], crossroads: tuple[Path, Path]
+) -> None:
+    net, demand = crossroads
+    env = make_env(net_file=net, route=("SJ", "JN"), demand_file=demand, warmup_s=0,
+                   max_steps=40)  # fmt: skip
+    obs, _ = env.reset(seed=0)
+    env.sumo.route.add("major", ["WJ", "JE"])
+    flagged = []
+    for i in range(40):
+        if i == 3:  # as above: the foe reaches J about 24 s in
+            env.sumo.vehicle.add("foe", "major", departPos="0", departSpeed="13.89")
+        # no shield: 3, 6, 9, 12 m/s, then 13 m/s, whatever lies ahead
+        before = env.route_pos_m
+        change = int(np.clip(13 - round(float(obs[S.V_EGO])), -3, 3))
+        obs, _r, terminated, truncated, info = env.step(change + 3)
+        if info["yield_violation"]:
+            flagged.append((before, env.route_pos_m))
+        if terminated or truncated:
+            break
+    # 35.1 m after 4 steps, then 13 m a step: the line at 292.8 m is crossed once, in the
+    # step from 282.1 m to 295.1 m, 20 steps later
+    assert flagged == [(pytest.approx(282.1), pytest.approx(295.1))]
 
 
 @pytest.mark.slow

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from explaindrive.commands import Command
 from explaindrive.env import state as S
 from explaindrive.env.lights import AmberDecision
-from explaindrive.env.right_of_way import YieldSensor
+from explaindrive.env.right_of_way import NO_YIELD, YieldReading, YieldSensor
 from explaindrive.sim.crossing_lanes import CrossingLane, pedestrian_in_lane
 from explaindrive.sim.pedestrians import KerbYield
 from explaindrive.sim.route import RouteCrossing, RouteGeometry
@@ -93,8 +93,8 @@ class Percept:
         crossings: the crossings ahead.
         light_colour: the true colour of the next light (the observation may show a yellow
             the ego goes through as green, :meth:`AmberDecision.shown_colour`).
-        yield_gap_m: to the nearest yield line where the ego must let a foe pass
-            (:class:`~explaindrive.env.right_of_way.YieldSensor`; sensor range: none).
+        yields: the yield lines where the ego must let a foe pass
+            (:class:`~explaindrive.env.right_of_way.YieldSensor`).
     """
 
     obs: NDArray[np.float32]
@@ -103,7 +103,7 @@ class Percept:
     links: tuple[SignalLink, ...]
     crossings: CrossingReading
     light_colour: S.LightState = S.LightState.GREEN
-    yield_gap_m: float = S.SENSOR_RANGE_M
+    yields: YieldReading = NO_YIELD
 
 
 class LeaderSensor:
@@ -342,7 +342,7 @@ class Perception:
             light = dataclasses.replace(light, colour=shown)
         crossings = self.crossings(api, pos_m, kerb)
         limit = self.geometry.posted_limit(pos_m)
-        yield_gap = self.yields(api, pos_m, v, limit)
-        leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m, yield_gap)
+        yields = self.yields(api, pos_m, v, limit)
+        leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m, yields.leader_gap_m)
         obs = observation(command, v, limit, leader, light, crossings.gap_m)
-        return Percept(obs, leader, real, links, crossings, true_colour, yield_gap)
+        return Percept(obs, leader, real, links, crossings, true_colour, yields)

@@ -2,10 +2,12 @@
 
 SUMO gives every link of a junction a state (a character of ``linkState`` or of the light's
 programme). An upper-case state has priority (``G`` green major, ``M`` major road of a
-priority junction, ``O`` a light switched off); a lower-case one must yield to the foes
-that have it: ``g`` a permissive turn at a light (a left turn across oncoming traffic on a
-shared green), ``m`` a minor road at a priority junction, ``s`` a stop sign, ``w`` an
-all-way stop, ``=`` right before left; ``Z`` (a zipper merge) yields too. SUMO's own
+priority junction, ``O`` a light switched off); the open lower-case ones
+(:data:`YIELD_STATES`) must yield to the foes that have it: ``g`` a permissive turn at a
+light (a left turn across oncoming traffic on a shared green), ``m`` a minor road at a
+priority junction, ``s`` a stop sign, ``w`` an all-way stop, ``=`` right before left, ``o``
+a blinking light switched off; ``Z`` (a zipper merge) yields too. Red, red-yellow and
+yellow (``r``, ``u``, ``y``) are the light's to judge (:mod:`explaindrive.env.lights`). SUMO's own
 drivers enter such a link only when no foe with priority will reach the conflict within
 their time gap (``MSLink::opened``).
 
@@ -52,6 +54,7 @@ prioritised vehicle, plus 1 s because the policy may not accelerate as hard as t
 time assumes."""
 MAX_ACCEL_MPS = max(SPEED_CHANGES_MPS)  # [m/s per step] the ego's hardest acceleration
 FOE_ACCEL_MPS2 = 2.6  # [m/s^2] a foe's acceleration when SUMO gives none (its default)
+YIELD_STATES = frozenset("gmsw=oZ")  # the ego's link states that yield to foes with priority
 NO_SIGNAL_STATES = frozenset("rRu")  # a foe at red or red-yellow does not enter
 _CLEAR_STEPS_MAX = 60  # steps after which a clearing time is taken as never
 
@@ -90,10 +93,10 @@ class FoeMotion:
     link_state: str = ""
 
 
-def link_has_priority(state: str) -> bool:
-    """Whether a link in ``state`` (a SUMO link-state character) enters without yielding:
-    an upper-case state other than the zipper's ``Z``."""
-    return state.isupper() and state != "Z"
+def link_yields(state: str) -> bool:
+    """Whether a link in ``state`` (a SUMO link-state character) is open but must yield to
+    foes with priority (:data:`YIELD_STATES`)."""
+    return state in YIELD_STATES
 
 
 def junction_of(internal_lane: str) -> str:
@@ -151,7 +154,7 @@ def must_yield(
         ego_limit_mps: the ego's posted limit (its top speed through the junction).
         ego_length_m: the ego's length.
     """
-    if link_has_priority(ego_link_state) or not foe.ego_responds:
+    if not link_yields(ego_link_state) or not foe.ego_responds:
         return False
     if motion.link_state in NO_SIGNAL_STATES:
         return False
@@ -164,8 +167,26 @@ def must_yield(
     return foe_arrives < ego_clear + YIELD_MARGIN_S
 
 
+class YieldReading(NamedTuple):
+    """The yield lines ahead this step [m] from the ego's front (sensor range: none).
+
+    Attributes:
+        leader_gap_m: to the nearest where the ego must yield and can still stop: a
+            virtual leader.
+        due_gap_m: to the nearest where the ego must yield, whether or not it can still
+            stop (what the yield-violation judge reads).
+    """
+
+    leader_gap_m: float = S.SENSOR_RANGE_M
+    due_gap_m: float = S.SENSOR_RANGE_M
+
+
+NO_YIELD = YieldReading()
+"""The reading with no yield line in force."""
+
+
 class YieldSensor:
-    """The nearest yield line ahead that is a virtual leader this step.
+    """The yield lines ahead where the ego must let a foe pass this step.
 
     Args:
         lines: ``(junction id, route position of its stop line [m])`` of the route's
@@ -204,25 +225,27 @@ class YieldSensor:
             float(api.vehicle.getAllowedSpeed(foe.foe_id)), kept[1], state,
         )  # fmt: skip
 
-    def __call__(self, api: Any, pos_m: float, speed_mps: float, limit_mps: float) -> float:
-        """[m] from the ego's front (at route position ``pos_m``) to the nearest yield line
-        where it must yield now (:func:`must_yield`) and can still stop; the sensor range
-        if there is none."""
+    def __call__(self, api: Any, pos_m: float, speed_mps: float, limit_mps: float) -> YieldReading:
+        """The yield lines ahead of the ego's front (at route position ``pos_m``) where it
+        must yield now (:func:`must_yield`): the nearest it can still stop before (a leader)
+        and the nearest of all."""
         foes = api.vehicle.getJunctionFoes(EGO_ID, S.SENSOR_RANGE_M)
         if not foes:
-            return S.SENSOR_RANGE_M
+            return NO_YIELD
         states = {junction_of(link[4]): link[5] for link in api.vehicle.getNextLinks(EGO_ID)}
-        nearest = S.SENSOR_RANGE_M
+        leader = due = S.SENSOR_RANGE_M
         for raw in foes:
             foe = JunctionFoe(*raw)
             junction = junction_of(foe.ego_lane)
             state = states.get(junction)
-            if state is None or link_has_priority(state) or not foe.ego_responds:
+            if state is None or not link_yields(state) or not foe.ego_responds:
                 continue
             gap = self.line_gap(junction, pos_m)
-            if gap is None or gap >= nearest or not can_stop_before(speed_mps, gap):
+            if gap is None or gap >= leader:
                 continue
             motion = self.foe_motion(api, foe)
             if must_yield(state, foe, motion, speed_mps, limit_mps, self.ego_length_m):
-                nearest = gap
-        return nearest
+                due = min(due, gap)
+                if can_stop_before(speed_mps, gap):
+                    leader = gap
+        return YieldReading(leader, due)

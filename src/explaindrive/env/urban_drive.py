@@ -238,7 +238,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         # violations are judged on what the ego saw before this step's observation
         assert seen is not None  # set by reset
         violations = ep.judge(self._sumo.api, prev_pos, ep.pos_m, seen.links,
-                              seen.crossings.in_lane)  # fmt: skip
+                              seen.crossings.in_lane, seen.yields.due_gap_m)  # fmt: skip
         ep.speed_mps, ep.accel_mps2 = motion.speed_mps, accel
         ep.apply_schedule()
         obs, leader, real = self._next_observation(motion, prev_obs)
