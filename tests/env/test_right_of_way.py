@@ -17,6 +17,7 @@ from explaindrive.env.right_of_way import (
     YIELD_MARGIN_S,
     FoeMotion,
     JunctionFoe,
+    YieldSensor,
     arrival_time_s,
     clear_time_s,
     junction_of,
@@ -88,6 +89,19 @@ def test_link_states_and_junction_ids() -> None:
     assert junction_of(":J_7_0") == "J"
     assert junction_of(":cluster_J1_J2_12_0") == "cluster_J1_J2"
     assert junction_of("SJ_0") == ""
+
+
+def test_foes_are_looked_for_up_to_the_last_yielding_link_before_an_unregulated_one() -> None:
+    lines = [("A", 50.0), ("B", 120.0), ("U", 150.0), ("C", 180.0)]
+    sensor = YieldSensor(lines, 5.0, unregulated=frozenset({"U"}))
+    links = [("x", True, True, False, f":{j}_0_0", state, "s", length)
+             for j, state, length in (("A", "M", 10.0), ("B", "m", 12.0), ("U", "M", 9.0),
+                                      ("C", "m", 11.0))]  # fmt: skip
+    # from 20 m: B's line 100 m ahead and its 12 m link, and a metre; C lies beyond U
+    assert sensor.horizon(links, 20.0) == ({"B": "m"}, 100.0 + 12.0 + 1.0)
+    # from 160 m, past U: C's line 20 m ahead
+    assert sensor.horizon(links, 160.0) == ({"C": "m"}, 20.0 + 11.0 + 1.0)
+    assert sensor.horizon(links[:1], 20.0) == ({}, 0.0)  # nothing yields: no look-up
 
 
 def _foe(foe_dist_m: float, foe_exit_m: float, ego_exit_m: float = 14.0) -> JunctionFoe:

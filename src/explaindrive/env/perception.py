@@ -297,6 +297,8 @@ class Perception:
         crossing_lanes: crossing edge -> the ego lane's stretch on it.
         leaders: the leader sensor.
         ego_length_m: the ego's length [m] (how long it takes to clear a junction).
+        unregulated: the ids of the route's ``unregulated`` junctions
+            (:class:`~explaindrive.env.right_of_way.YieldSensor`).
     """
 
     def __init__(
@@ -305,12 +307,13 @@ class Perception:
         crossing_lanes: dict[str, CrossingLane],
         leaders: LeaderSensor,
         ego_length_m: float,
+        unregulated: frozenset[str] = frozenset(),
     ) -> None:
         self.geometry = geometry
         self.leaders = leaders
         self.crossings = CrossingSensor(geometry.crossings, crossing_lanes)
         lines = ((j.node_id, j.start_m) for j in geometry.junctions)
-        self.yields = YieldSensor(lines, ego_length_m)
+        self.yields = YieldSensor(lines, ego_length_m, unregulated)
 
     def __call__(
         self,

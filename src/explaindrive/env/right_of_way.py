@@ -34,6 +34,12 @@ and braking would only leave it in the conflict (the yellow light's dilemma zone
 :mod:`explaindrive.env.lights`). A line behind the ego's front (it is inside the junction)
 is none either: SUMO's drivers wait inside a junction for a left turn at its internal
 junction, which the ego does not model.
+
+``getJunctionFoes`` is asked only when a yielding link lies within sensor range, and only as
+far as the last such link: SUMO 1.28's libsumo crashes (a segmentation fault) when its
+look-ahead reaches an ``unregulated`` junction (one without junction logic, such as the
+centre of netgenerate's spider networks), so the look-ahead also stops before the first one
+on the route; a yielding link beyond it is read once the ego has passed it.
 """
 
 from __future__ import annotations
@@ -192,11 +198,18 @@ class YieldSensor:
         lines: ``(junction id, route position of its stop line [m])`` of the route's
             junctions, in route order.
         ego_length_m: the ego's length [m].
+        unregulated: the ids of the route's ``unregulated`` junctions (module docstring).
     """
 
-    def __init__(self, lines: Iterable[tuple[str, float]], ego_length_m: float) -> None:
+    def __init__(
+        self,
+        lines: Iterable[tuple[str, float]],
+        ego_length_m: float,
+        unregulated: frozenset[str] = frozenset(),
+    ) -> None:
         self.lines = tuple(lines)
         self.ego_length_m = ego_length_m
+        self.unregulated = unregulated
         self._types: dict[str, tuple[float, float]] = {}  # foe id -> (accel, length)
 
     def line_gap(self, junction: str, pos_m: float) -> float | None:
@@ -225,14 +238,32 @@ class YieldSensor:
             float(api.vehicle.getAllowedSpeed(foe.foe_id)), kept[1], state,
         )  # fmt: skip
 
+    def horizon(self, links: Iterable[Any], pos_m: float) -> tuple[dict[str, str], float]:
+        """The yielding links among ``links`` (``vehicle.getNextLinks``, in route order)
+        within sensor range and before the first unregulated junction: junction id -> link
+        state, and how far to look for their foes [m] (to the end of the last one)."""
+        states: dict[str, str] = {}
+        reach = 0.0
+        for link in links:
+            junction, state = junction_of(link[4]), link[5]
+            gap = self.line_gap(junction, pos_m)
+            if gap is None:  # a link out of the junction the ego is in: no line ahead
+                continue
+            if gap >= S.SENSOR_RANGE_M or junction in self.unregulated:
+                break
+            if link_yields(state):
+                states[junction] = state
+                reach = gap + float(link[7]) + 1.0  # [m] its whole length, and a metre
+        return states, reach
+
     def __call__(self, api: Any, pos_m: float, speed_mps: float, limit_mps: float) -> YieldReading:
         """The yield lines ahead of the ego's front (at route position ``pos_m``) where it
         must yield now (:func:`must_yield`): the nearest it can still stop before (a leader)
         and the nearest of all."""
-        foes = api.vehicle.getJunctionFoes(EGO_ID, S.SENSOR_RANGE_M)
-        if not foes:
+        states, reach = self.horizon(api.vehicle.getNextLinks(EGO_ID), pos_m)
+        if not states:
             return NO_YIELD
-        states = {junction_of(link[4]): link[5] for link in api.vehicle.getNextLinks(EGO_ID)}
+        foes = api.vehicle.getJunctionFoes(EGO_ID, reach)
         leader = due = S.SENSOR_RANGE_M
         for raw in foes:
             foe = JunctionFoe(*raw)

@@ -105,6 +105,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self.scenario: ScenarioFiles = self._scenarios.current
         self.geometry: RouteGeometry
         self._crossing_lanes: dict[str, CrossingLane]
+        self._unregulated: frozenset[str]  # the route's junctions without junction logic
         self._load_geometry(self.scenario)
         if cfg.normalize_obs:
             low, high = S.normalize(S.STATE_LOW), S.normalize(S.STATE_HIGH)
@@ -187,7 +188,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise
         self._entry = entry
         leaders = LeaderSensor(entry.min_gap_m, self._leader_lengths)
-        perception = Perception(self.geometry, self._crossing_lanes, leaders, entry.length_m)
+        perception = Perception(
+            self.geometry, self._crossing_lanes, leaders, entry.length_m, self._unregulated
+        )
         self._ep = ep = Episode(
             command=opts.command,
             schedule=list(opts.command_schedule),
@@ -363,6 +366,11 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         """The route's geometry and the ego lane's stretch on each of its crossings."""
         net = read_net(scenario.net_file)
         self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges, net)
+        self._unregulated = frozenset(
+            j.node_id
+            for j in self.geometry.junctions
+            if net.getNode(j.node_id).getType() == "unregulated"
+        )
         self._crossing_lanes = crossing_lanes(
             scenario.net_file,
             {c.crossing_edge: c.approach_edge for c in self.geometry.crossings},
