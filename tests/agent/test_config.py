@@ -204,7 +204,7 @@ ADDED_FIELDS = {
     "priority_alpha": 0.0, "priority_beta": 0.4, "priority_beta_steps": 400_000,
     "boundary_weight": 0.0, "boundary_margin": None, "limit_margin": None, "n_step_cut": False,
     "boundary_noise": False, "speed_noisy_share": None, "near_range_m": None,
-    "speed_estimate": False, "stop_window_m": None,
+    "speed_estimate": False, "stop_window_m": None, "speed_limiter": False,
 }  # fmt: skip
 """Fields added after the shipped cards were written, with their defaults (uniform replay)."""
 
@@ -213,7 +213,10 @@ def _with_added_fields(saved: dict[str, Any]) -> dict[str, Any]:
     return {**{k: v for k, v in ADDED_FIELDS.items() if k not in saved}, **saved}
 
 
-PRESET_CHANGED_SINCE: dict[str, dict[str, Any]] = {"fast": {}, "comfort": {}}
+PRESET_CHANGED_SINCE: dict[str, dict[str, Any]] = {
+    "fast": {"speed_limiter": False},
+    "comfort": {"speed_limiter": False},
+}
 """Per shipped card, the passenger preset's settings it was trained before (with their value
 on the card)."""
 

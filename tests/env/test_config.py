@@ -31,7 +31,8 @@ def test_unknown_key_is_named() -> None:
     assert str(err.value) == (
         "unknown env config key(s): max_step; known keys: cache_dir, demand_file, ego_model, "
         "insert_timeout_s, max_steps, net_file, normalize_obs, obs_noise, reward, route, "
-        "scenario, scenario_every, scenario_paper_share, stop_window_m, traffic_level, warmup_s, "
+        "scenario, scenario_every, scenario_paper_share, speed_limiter, stop_window_m, "
+        "traffic_level, warmup_s, "
         "yellow_leader"
     )
     with pytest.raises(ConfigError, match=r"^unknown env config key\(s\): trafic_level; "):

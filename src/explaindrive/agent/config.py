@@ -179,6 +179,11 @@ class TrainConfig(ConfigModel, ScenarioFields):
     """``(min, max)`` metres before the line within which the reward pays standing for a
     light or a pedestrian; ``None``: the recipe's own
     (:attr:`~explaindrive.env.reward.RewardWeights.stop_window_m`)."""
+    speed_limiter: bool = False
+    """The speed limiter (Intelligent Speed Assistance): a speed rise that would pass the
+    posted limit lands on it (:func:`~explaindrive.env.actions.limited_speed`), in the
+    environment, the safety masks and the shield. ``passenger`` turns it on; ``paper`` keeps
+    the paper's dynamics."""
     obs_noise_max: NoiseSD = (0.0, 0.0)
     """``(sd_m, sd_mps)``: a share ``noisy_share`` of the episodes draws its observation noise
     uniformly between 0 and these (domain randomisation, :mod:`explaindrive.env.noise`);
@@ -324,8 +329,10 @@ PASSENGER = SAFE.replace(
     stop_when_safe=None,
     scenario="random",
     scenario_paper_share=0.25,
+    speed_limiter=True,
 )
-"""The default: ``safe``'s learning with the ``passenger`` reward recipe and the ``gentle``
+"""The default: ``safe``'s learning with the ``passenger`` reward recipe, the speed limiter
+(:func:`~explaindrive.env.actions.limited_speed`) and the ``gentle``
 decision at yellow (:mod:`explaindrive.env.lights`) over 1,200 episodes (the shipped
 networks' budget), the unsafe-action loss also on synthetic rows near the safety boundary at
 a quarter of its weight (:mod:`explaindrive.agent.boundary`), observation noise up to 3 m /

@@ -83,6 +83,12 @@ class QPolicy:
         ``config.yellow_leader``; a card without it predates the field: the default)."""
         return str(self.card.get("config", {}).get("yellow_leader", DEFAULT_YELLOW_LEADER))
 
+    @property
+    def speed_limiter(self) -> bool:
+        """Whether the network was trained with the speed limiter on (its card's
+        ``config.speed_limiter``; a card without it predates the limiter: off)."""
+        return bool(self.card.get("config", {}).get("speed_limiter", False))
+
 
 class CommandSource(Protocol):
     """What holds the passenger's command: :class:`~explaindrive.env.urban_drive.UrbanDriveEnv`."""
@@ -157,6 +163,22 @@ class MergedController:
             )
         return rules.pop()
 
+    @property
+    def speed_limiter(self) -> bool:
+        """Whether the car drives with the speed limiter: when the networks were trained
+        with it (both must agree, as on :attr:`yellow_leader`).
+
+        Raises:
+            CheckpointError: if the two networks were trained differently.
+        """
+        limiters = {p.speed_limiter for p in self.policies.values()}
+        if len(limiters) > 1:
+            raise CheckpointError(
+                "the fast and comfort networks were trained one with the speed limiter and "
+                "one without; merge networks trained alike"
+            )
+        return limiters.pop()
+
     @classmethod
     def from_files(
         cls, fast_path: str | Path, comfort_path: str | Path, use_shield: bool = True
@@ -227,7 +249,7 @@ class MergedController:
             steps_left = self._stop_steps_left
             self._stop_steps_left = max(1, self._stop_steps_left - 1)
         q_values = self.policy.q_values(x)
-        decision = shield(x, q_values, steps_left)
+        decision = shield(x, q_values, steps_left, self.policy.speed_limiter)
         self.steps += 1
         self.last_network_action = int(np.argmax(q_values))
         self.last_override = decision.overridden

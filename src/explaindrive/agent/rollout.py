@@ -57,6 +57,7 @@ def make_urban_drive_env(
     scenario: Mapping[str, Any] | None = None,
     reward: str = "paper",
     stop_window_m: tuple[float, float] | None = None,
+    speed_limiter: bool = False,
 ) -> gym.Env:
     """The project's SUMO environment (imported lazily: each worker builds its own) in the
     ``scenario`` chosen by these env config fields (the paper's road by default)."""
@@ -67,6 +68,7 @@ def make_urban_drive_env(
         yellow_leader=yellow_leader,
         reward=reward,
         stop_window_m=stop_window_m,
+        speed_limiter=speed_limiter,
         **dict(scenario or {}),
     )
     return UrbanDriveEnv(
@@ -83,6 +85,7 @@ def default_env_factory(config: TrainConfig) -> EnvFactory:
         config.scenario_fields(),
         config.reward,
         config.stop_window_m,
+        config.speed_limiter,
     )
 
 
@@ -99,15 +102,18 @@ def _allowed(info: dict[str, Any]) -> np.ndarray:
     return np.asarray(info["action_mask"], dtype=bool)
 
 
-def learning_mask(seen: np.ndarray, true: np.ndarray, dilemma_braking: bool) -> np.ndarray:
+def learning_mask(
+    seen: np.ndarray, true: np.ndarray, dilemma_braking: bool, speed_limiter: bool = False
+) -> np.ndarray:
     """The safe actions learning uses: the training mask of the true state and, when the
     network sees a noisy speed, the posted-limit rule on what it sees as well (a car that
     sees itself over the limit slows down, which keeps a margin below the limit under
-    noise). If the two leave nothing, the true state's mask alone."""
-    mask = training_mask(true, dilemma_braking)
+    noise). If the two leave nothing, the true state's mask alone. ``speed_limiter``: both
+    through the speed limiter."""
+    mask = training_mask(true, dilemma_braking, speed_limiter)
     if seen is true:
         return mask
-    both = mask & limit_mask(seen)
+    both = mask & limit_mask(seen, speed_limiter)
     return both if both.any() else mask
 
 
@@ -311,7 +317,8 @@ class RolloutWorker:
             return _Running(
                 plan, summary, NStepQueue(c.n_step, c.gamma, c.n_step_cut),
                 np.random.default_rng([c.seed, 3, plan.index]), obs,
-                learning_mask(obs, true_obs, c.dilemma_braking), _allowed(info), estimator,
+                learning_mask(obs, true_obs, c.dilemma_braking, c.speed_limiter),
+                _allowed(info), estimator,
             )  # fmt: skip
         raise RuntimeError(
             f"worker {self.worker_id}: episode {plan.index} failed to start "
@@ -333,7 +340,9 @@ class RolloutWorker:
         next_true = _true_state(next_obs, info)
         if ep.estimator is not None:
             next_obs[V_EGO] = ep.estimator.update(float(next_obs[V_EGO]), speed_change(action))
-        next_mask = learning_mask(next_obs, next_true, self.config.dilemma_braking)
+        next_mask = learning_mask(
+            next_obs, next_true, self.config.dilemma_braking, self.config.speed_limiter
+        )
         done = bool(terminated or truncated)
         out.transitions += ep.queue.push(
             ep.obs, action, float(reward), ep.mask, next_obs, next_mask, bool(terminated), done,

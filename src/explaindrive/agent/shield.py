@@ -6,7 +6,8 @@ time (:func:`shield`) braking in a yellow light's dilemma zone is unsafe; the tr
 leaves it allowed. Under STOP the shield also keeps the stop within its latency bound
 (ceil(v/3) + 2 steps from the command); the training mask asks instead that every step
 under STOP brings the standstill one hardest-braking step closer, which keeps that bound
-without knowing when the command came.
+without knowing when the command came. With the speed limiter (``speed_limiter``, the
+``passenger`` preset's) actions are judged by the speed the limiter lands them on.
 """
 
 from __future__ import annotations
@@ -55,9 +56,10 @@ class ShieldDecision:
     overridden: bool
 
 
-def is_safe(obs: NDArray[np.floating], action: int) -> bool:
-    """Whether ``action`` keeps a stopping option and respects the posted limit."""
-    return bool(safe_action_mask(obs)[action])
+def is_safe(obs: NDArray[np.floating], action: int, speed_limiter: bool = False) -> bool:
+    """Whether ``action`` keeps a stopping option and respects the posted limit
+    (``speed_limiter``: through the speed limiter)."""
+    return bool(safe_action_mask(obs, speed_limiter=speed_limiter)[action])
 
 
 def stop_in_time(speed_mps: float, action: int, steps_left: int) -> bool:
@@ -71,6 +73,7 @@ def shield(
     obs: NDArray[np.floating],
     q_values: Sequence[float] | NDArray[np.floating],
     stop_steps_left: int | None = None,
+    speed_limiter: bool = False,
 ) -> ShieldDecision:
     """The best-valued safe action for a raw observation.
 
@@ -79,9 +82,10 @@ def shield(
         q_values: the policy's Q-values, one per action.
         stop_steps_left: under STOP, the steps left to reach a standstill; actions that
             would miss it are not allowed.
+        speed_limiter: judge the actions through the speed limiter.
     """
     order = np.argsort(-np.asarray(q_values, dtype=np.float64), kind="stable")
-    mask = safe_action_mask(obs)
+    mask = safe_action_mask(obs, speed_limiter=speed_limiter)
     v = float(obs[S.V_EGO])
     for rank, a in enumerate(order):
         late = (

@@ -1,4 +1,11 @@
-"""The action space: a change of the ego speed per 1 s decision step."""
+"""The action space: a change of the ego speed per 1 s decision step.
+
+With the speed limiter (Intelligent Speed Assistance, as new cars in the EU carry it; the
+``passenger`` preset's ``speed_limiter``), a rise that would pass the posted limit lands on
+the limit instead (:func:`limited_speed`): whole-m/s changes can then hold 13.89 m/s. It
+never brakes: a car already above the limit keeps its speed on a rise. The ``paper`` preset
+keeps the paper's dynamics (no limiter); speeding is judged on the true speed either way.
+"""
 
 from __future__ import annotations
 
@@ -42,9 +49,20 @@ def action_index(change_mps: int) -> int:
     return SPEED_CHANGES_MPS.index(change_mps)
 
 
-def next_speed(v_mps: float, action: int) -> float:
-    """Ego speed after applying ``action`` for one step, clipped at 0."""
-    return max(0.0, v_mps + speed_change(action))
+def limited_speed(v_mps: float, change_mps: float, limit_mps: float | None) -> float:
+    """[m/s] The speed after a change of ``change_mps`` from ``v_mps``, clipped at 0; with a
+    posted limit ``limit_mps`` (the speed limiter on), a rise that would pass it lands on it,
+    or keeps the speed when that is above it (``None``: no limiter)."""
+    v_new = max(0.0, v_mps + change_mps)
+    if limit_mps is not None and change_mps > 0 and v_new > limit_mps:
+        return max(v_mps, limit_mps)
+    return v_new
+
+
+def next_speed(v_mps: float, action: int, limit_mps: float | None = None) -> float:
+    """Ego speed after applying ``action`` for one step, clipped at 0; with ``limit_mps``,
+    through the speed limiter (:func:`limited_speed`)."""
+    return limited_speed(v_mps, speed_change(action), limit_mps)
 
 
 def braking_distances(

@@ -45,6 +45,10 @@ class EnvConfig(ConfigModel, ScenarioFields):
             the true state, which ``info["true_obs"]`` holds when noise is on.
         stop_window_m: ``(min, max)`` metres before the line within which the reward pays
             standing for a light or a pedestrian; ``None``: the recipe's own.
+        speed_limiter: the speed limiter (Intelligent Speed Assistance) is on: a speed rise
+            that would pass the posted limit lands on it
+            (:func:`~explaindrive.env.actions.limited_speed`); the ``passenger`` preset's.
+            Speeding is still judged on the true speed.
     """
 
     config_name = "env config"
@@ -60,6 +64,7 @@ class EnvConfig(ConfigModel, ScenarioFields):
     reward: Annotated[str, one_of(REWARD_NAMES)] = "paper"
     obs_noise: NoiseSD = Field(default=(0.0, 0.0))
     stop_window_m: StopWindow | None = None
+    speed_limiter: bool = False
 
     @property
     def noise(self) -> ObservationNoise:

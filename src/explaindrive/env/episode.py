@@ -174,6 +174,7 @@ class StepRecord:
             "collision": self.motion.collided,
             "red_light_run": self.violations.red_light_run,
             "ped_violation": self.violations.ped_violation,
+            "yield_violation": self.violations.yield_violation,
             "speeding": speeding(v, legal_limit_mps),
             "site": self.violations.site,
             "arrived": self.motion.arrived,

@@ -74,6 +74,10 @@ class EpisodeResult:
     violations_by_site: dict[str, dict[str, int]] = field(default_factory=dict)
     """Site -> kind -> count (module docstring); empty for an episode stored before sites
     were recorded."""
+    yield_violations: int = 0
+    """Yield lines crossed while a foe with priority was within the gap
+    (:mod:`explaindrive.env.violations`); not yet in :attr:`violations` nor split by site
+    (0 for an episode stored before it was counted)."""
 
     @property
     def violations(self) -> int:
@@ -127,6 +131,7 @@ class EpisodeMetrics:
     _unfinished: int = 0
     ride: RideQuality = field(default_factory=RideQuality)
     by_site: dict[str, dict[str, int]] = field(default_factory=no_violations_by_site)
+    yield_violations: int = 0
 
     def update(self, info: dict[str, Any], reward: float = 0.0) -> None:
         """Add one step's ``info`` (and reward)."""
@@ -143,6 +148,7 @@ class EpisodeMetrics:
         self.red_light_runs += int(bool(info["red_light_run"]))
         self.ped_violations += int(bool(info["ped_violation"]))
         self.speeding_steps += int(bool(info["speeding"]))
+        self.yield_violations += int(bool(info.get("yield_violation", False)))
         at_site = self.by_site[info["site"]]
         for kind, flag in zip(VIOLATION_KINDS, _INFO_FLAGS, strict=True):
             at_site[kind] += int(bool(info[flag]))
@@ -193,6 +199,7 @@ class EpisodeMetrics:
             total_reward=self.total_reward,
             ride=self.ride.result(),
             violations_by_site={site: dict(n) for site, n in self.by_site.items()},
+            yield_violations=self.yield_violations,
         )
 
 

@@ -1,10 +1,14 @@
-"""What the ego perceives each step: its leader, the next light, the next busy crossing, and
-the paper's 8-dim observation built from them.
+"""What the ego perceives each step: its leader, the next light, the next busy crossing, the
+next yield line it must hold at, and the paper's 8-dim observation built from them.
 
 The lights are read link by link from SUMO (``vehicle.getNextTLS``): the stop line and the
 signal index of the link the ego will actually use, from the lane it is on, through its
 connection to the next edge of its route, with that connection's ``linkIndex`` in the
 programme. A joined cluster's several stop lines are each a link of their own.
+
+A junction where the ego must let a foe with priority pass first (a minor road, a permissive
+turn, a merge: :mod:`explaindrive.env.right_of_way`) puts a virtual leader at its stop line,
+as a red light does; the observation keeps its 8 dimensions.
 
 Each sensor is a small object that reads the running simulation and returns a value; none
 writes episode state. :class:`Perception` combines them into a :class:`Percept`.
@@ -23,6 +27,7 @@ from numpy.typing import NDArray
 from explaindrive.commands import Command
 from explaindrive.env import state as S
 from explaindrive.env.lights import AmberDecision
+from explaindrive.env.right_of_way import NO_YIELD, YieldReading, YieldSensor
 from explaindrive.sim.crossing_lanes import CrossingLane, pedestrian_in_lane
 from explaindrive.sim.pedestrians import KerbYield
 from explaindrive.sim.route import RouteCrossing, RouteGeometry
@@ -88,6 +93,8 @@ class Percept:
         crossings: the crossings ahead.
         light_colour: the true colour of the next light (the observation may show a yellow
             the ego goes through as green, :meth:`AmberDecision.shown_colour`).
+        yields: the yield lines where the ego must let a foe pass
+            (:class:`~explaindrive.env.right_of_way.YieldSensor`).
     """
 
     obs: NDArray[np.float32]
@@ -96,6 +103,7 @@ class Percept:
     links: tuple[SignalLink, ...]
     crossings: CrossingReading
     light_colour: S.LightState = S.LightState.GREEN
+    yields: YieldReading = NO_YIELD
 
 
 class LeaderSensor:
@@ -234,15 +242,21 @@ class CrossingSensor:
 
 
 def effective_leader(
-    real: Leader | None, light_line: bool, light_gap_m: float, crossing_gap_m: float
+    real: Leader | None,
+    light_line: bool,
+    light_gap_m: float,
+    crossing_gap_m: float,
+    yield_gap_m: float = S.SENSOR_RANGE_M,
 ) -> Leader | None:
     """The nearest of the real leader, the stop line of a light that is a virtual leader
-    (``light_line``) and a busy crossing in range."""
+    (``light_line``), a busy crossing in range and a yield line in range where the ego must
+    let a foe pass."""
     leader = real
     if light_line and (leader is None or light_gap_m < leader.gap_m):
         leader = Leader(max(light_gap_m, 0.0), 0.0, 0.0, True)
-    if crossing_gap_m < S.SENSOR_RANGE_M and (leader is None or crossing_gap_m < leader.gap_m):
-        leader = Leader(crossing_gap_m, 0.0, 0.0, True)
+    for gap_m in (crossing_gap_m, yield_gap_m):
+        if gap_m < S.SENSOR_RANGE_M and (leader is None or gap_m < leader.gap_m):
+            leader = Leader(gap_m, 0.0, 0.0, True)
     return leader
 
 
@@ -282,6 +296,9 @@ class Perception:
         geometry: the route's geometry.
         crossing_lanes: crossing edge -> the ego lane's stretch on it.
         leaders: the leader sensor.
+        ego_length_m: the ego's length [m] (how long it takes to clear a junction).
+        unregulated: the ids of the route's ``unregulated`` junctions
+            (:class:`~explaindrive.env.right_of_way.YieldSensor`).
     """
 
     def __init__(
@@ -289,10 +306,14 @@ class Perception:
         geometry: RouteGeometry,
         crossing_lanes: dict[str, CrossingLane],
         leaders: LeaderSensor,
+        ego_length_m: float,
+        unregulated: frozenset[str] = frozenset(),
     ) -> None:
         self.geometry = geometry
         self.leaders = leaders
         self.crossings = CrossingSensor(geometry.crossings, crossing_lanes)
+        lines = ((j.node_id, j.start_m) for j in geometry.junctions)
+        self.yields = YieldSensor(lines, ego_length_m, unregulated)
 
     def __call__(
         self,
@@ -323,7 +344,8 @@ class Perception:
         if shown is not true_colour:
             light = dataclasses.replace(light, colour=shown)
         crossings = self.crossings(api, pos_m, kerb)
-        leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m)
         limit = self.geometry.posted_limit(pos_m)
+        yields = self.yields(api, pos_m, v, limit)
+        leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m, yields.leader_gap_m)
         obs = observation(command, v, limit, leader, light, crossings.gap_m)
-        return Percept(obs, leader, real, links, crossings, true_colour)
+        return Percept(obs, leader, real, links, crossings, true_colour, yields)

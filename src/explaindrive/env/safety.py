@@ -8,6 +8,10 @@ An action is safe when, after it, the ego could still stop braking at -3 m/s per
 - before a red or yellow light and before an occupied crossing (the virtual leaders);
 - without exceeding the posted limit (above it, only the hardest braking is safe).
 
+With the speed limiter (``speed_limiter=True``, the ``passenger`` preset's;
+:func:`~explaindrive.env.actions.limited_speed`) an action is judged by the speed it lands
+on: a rise that would pass the limit lands on it, so it does not exceed the limit.
+
 Standing still after the step is safe with respect to every stop line and leader.
 
 A yellow light that even the hardest braking cannot stop for is the dilemma zone: the
@@ -81,10 +85,14 @@ class ActionOutcomes(NamedTuple):
     """It brakes less than the hardest braking."""
 
 
-def action_outcomes(speed_mps: NDArray[np.float64] | float) -> ActionOutcomes:
-    """The :class:`ActionOutcomes` of speeds of shape ``(B, 1)``, or of one speed."""
+def action_outcomes(
+    speed_mps: NDArray[np.float64] | float, cap_mps: NDArray[np.float64] | float = math.inf
+) -> ActionOutcomes:
+    """The :class:`ActionOutcomes` of speeds of shape ``(B, 1)``, or of one speed; rises
+    stop at ``cap_mps`` (the speed limiter's ``max(v, limit)``; ``inf``: no limiter)."""
     v = speed_mps
     v_new = np.maximum(v + _CHANGES, 0.0)
+    v_new = np.where(_CHANGES > 0, np.minimum(v_new, cap_mps), v_new)
     return ActionOutcomes(
         v_new=v_new,
         need=stopping_needs(v_new),
@@ -97,7 +105,10 @@ def action_outcomes(speed_mps: NDArray[np.float64] | float) -> ActionOutcomes:
 
 
 def safe_action_mask(
-    obs: NDArray[np.floating], dilemma_braking: bool = False, stop_progress: bool = False
+    obs: NDArray[np.floating],
+    dilemma_braking: bool = False,
+    stop_progress: bool = False,
+    speed_limiter: bool = False,
 ) -> NDArray[np.bool_]:
     """Which of the 7 actions are safe in each raw observation.
 
@@ -108,27 +119,32 @@ def safe_action_mask(
             hardest braking needs one step fewer to a standstill (and, at a standstill,
             only staying there); in the dilemma zone keeping the speed is allowed too, to
             clear the junction before stopping.
+        speed_limiter: judge each action by the speed the speed limiter lands it on.
 
     Returns:
         Boolean mask of shape ``(B, 7)`` (``(7,)`` for one observation). A row may be all
         false: then no action keeps a stopping option (see :func:`training_mask`).
     """
-    return _mask(obs, dilemma_braking, stop_progress, fallback=False)
+    return _mask(obs, dilemma_braking, stop_progress, fallback=False, limiter=speed_limiter)
 
 
 def _mask(
-    obs: NDArray[np.floating], dilemma_braking: bool, stop_progress: bool, fallback: bool
+    obs: NDArray[np.floating],
+    dilemma_braking: bool,
+    stop_progress: bool,
+    fallback: bool,
+    limiter: bool = False,
 ) -> NDArray[np.bool_]:
     """:func:`safe_action_mask`; with ``fallback``, rows that allow nothing allow the
-    hardest braking (what the shield does there)."""
+    hardest braking (what the shield does there); ``limiter``: the speed limiter is on."""
     x = np.asarray(obs)
     if x.ndim == 1:  # one observation: the rule in plain Python, one numpy call
-        unsafe = _unsafe_one(x.tolist(), dilemma_braking, stop_progress)
+        unsafe = _unsafe_one(x.tolist(), dilemma_braking, stop_progress, limiter)
         safe = [not u for u in unsafe]
         if fallback and not any(safe):
             safe[HARDEST_BRAKE] = True
         return np.array(safe, dtype=np.bool_)
-    columns, outcomes = _columns(x.astype(np.float64, copy=False))
+    columns, outcomes = _columns(x.astype(np.float64, copy=False), limiter)
     mask = ~_unsafe(columns, outcomes, dilemma_braking, stop_progress)
     if fallback:
         rows = mask.reshape(-1, len(SPEED_CHANGES_MPS))
@@ -136,11 +152,15 @@ def _mask(
     return mask
 
 
-def _columns(x: NDArray[np.float64]) -> tuple[tuple[Any, ...], ActionOutcomes]:
+def _columns(
+    x: NDArray[np.float64], limiter: bool = False
+) -> tuple[tuple[Any, ...], ActionOutcomes]:
     """The 8 components of raw observations ``(B, 8)``, each a column ``(B, 1)``, and the
-    :class:`ActionOutcomes` of their speeds."""
+    :class:`ActionOutcomes` of their speeds (through the speed limiter with ``limiter``)."""
     rows = x.reshape(-1, S.STATE_DIM)
-    return tuple(rows.T[:, :, None]), action_outcomes(rows[:, S.V_EGO : S.V_EGO + 1])
+    v = rows[:, S.V_EGO : S.V_EGO + 1]
+    cap = np.maximum(v, rows[:, S.V_LIM : S.V_LIM + 1]) if limiter else math.inf
+    return tuple(rows.T[:, :, None]), action_outcomes(v, cap)
 
 
 def _unsafe(
@@ -215,10 +235,10 @@ class _Action(NamedTuple):
 
 
 @lru_cache(maxsize=SPEEDS_KEPT)
-def _actions_at(speed_mps: float) -> tuple[tuple[_Action, ...], float]:
-    """The 7 actions' outcomes at one speed and ``least_need``, kept per speed (the speeds
-    of an episode repeat)."""
-    o = action_outcomes(speed_mps)
+def _actions_at(speed_mps: float, cap_mps: float = math.inf) -> tuple[tuple[_Action, ...], float]:
+    """The 7 actions' outcomes at one speed (rises stopping at ``cap_mps``) and
+    ``least_need``, kept per speed (the speeds of an episode repeat)."""
+    o = action_outcomes(speed_mps, cap_mps)
     columns = (o.v_new, o.need, o.slows, o.keeps, o.closer, o.eases)
     actions = tuple(_Action(*row) for row in zip(*(c.tolist() for c in columns), strict=True))
     return actions, float(o.least_need)
@@ -229,12 +249,15 @@ def _code(value: float) -> float:
     return round(value) if math.isfinite(value) else value
 
 
-def _unsafe_one(values: list[float], dilemma_braking: bool, stop_progress: bool) -> list[bool]:
+def _unsafe_one(
+    values: list[float], dilemma_braking: bool, stop_progress: bool, limiter: bool = False
+) -> list[bool]:
     """The rule of :func:`_unsafe` for one observation's 8 components: which actions are
     unsafe. Standing still after an action needs its ``need`` ahead: the room up to the
-    nearest busy crossing, light to stop for and point where the real leader could stop."""
+    nearest busy crossing, light to stop for and point where the real leader could stop.
+    ``limiter``: the speed limiter is on."""
     cmd, v, v_lim, gap, dv, d_tl, tls, d_cross = values
-    actions, least_need = _actions_at(v)
+    actions, least_need = _actions_at(v, max(v, v_lim) if limiter else math.inf)
     room = d_cross if d_cross < S.SENSOR_RANGE_M else math.inf
     tls = _code(tls)
     signal = tls != 0
@@ -258,27 +281,32 @@ def _unsafe_one(values: list[float], dilemma_braking: bool, stop_progress: bool)
     ]
 
 
-def limit_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
+def limit_mask(obs: NDArray[np.floating], speed_limiter: bool = False) -> NDArray[np.bool_]:
     """The posted-limit rule of :func:`safe_action_mask` alone, for raw observations of shape
-    ``(B, 8)`` (or ``(8,)``)."""
+    ``(B, 8)`` (or ``(8,)``); ``speed_limiter``: through the speed limiter."""
     x = np.asarray(obs)
     if x.ndim == 1:
         values = x.tolist()
-        actions, _ = _actions_at(values[S.V_EGO])
-        return np.array([not a.over(values[S.V_LIM]) for a in actions], dtype=np.bool_)
-    columns, outcomes = _columns(x.astype(np.float64, copy=False))
+        v, v_lim = values[S.V_EGO], values[S.V_LIM]
+        actions, _ = _actions_at(v, max(v, v_lim) if speed_limiter else math.inf)
+        return np.array([not a.over(v_lim) for a in actions], dtype=np.bool_)
+    columns, outcomes = _columns(x.astype(np.float64, copy=False), speed_limiter)
     return ~_over_limit(columns[S.V_LIM], outcomes)
 
 
-def training_mask(obs: NDArray[np.floating], dilemma_braking: bool = True) -> NDArray[np.bool_]:
+def training_mask(
+    obs: NDArray[np.floating], dilemma_braking: bool = True, speed_limiter: bool = False
+) -> NDArray[np.bool_]:
     """The safety mask learning uses: dilemma braking allowed unless ``dilemma_braking`` is
     false, STOP must make progress, and the hardest braking where nothing is safe (every row
-    allows an action)."""
-    return _mask(obs, dilemma_braking, stop_progress=True, fallback=True)
+    allows an action); ``speed_limiter``: through the speed limiter."""
+    return _mask(obs, dilemma_braking, stop_progress=True, fallback=True, limiter=speed_limiter)
 
 
-def runtime_mask(obs: NDArray[np.floating]) -> NDArray[np.bool_]:
+def runtime_mask(obs: NDArray[np.floating], speed_limiter: bool = False) -> NDArray[np.bool_]:
     """The actions the run-time shield keeps (dilemma braking forbidden), with STOP's
     progress rule standing in for its latency bound: a greedy action outside this mask is
-    one the shield would override."""
-    return _mask(obs, dilemma_braking=False, stop_progress=True, fallback=True)
+    one the shield would override. ``speed_limiter``: through the speed limiter."""
+    return _mask(
+        obs, dilemma_braking=False, stop_progress=True, fallback=True, limiter=speed_limiter
+    )

@@ -4,6 +4,11 @@ Each step is 1 s. The action changes the ego speed by -3..+3 m/s; SUMO's own
 safety checks for the ego are off (speed mode 0), so collisions, red-light runs,
 pedestrian-yield and speed-limit violations can happen and are counted.
 
+In the ``passenger`` preset the speed limiter is on (``speed_limiter``,
+:func:`~explaindrive.env.actions.limited_speed`): a rise that would pass the posted limit
+lands on it. ``change`` in the step's record stays the action's; the acceleration is the
+speed's true change.
+
 The environment composes small parts: :mod:`~explaindrive.env.sumo_process` (SUMO, the
 warm-up, the ego's entry), :mod:`~explaindrive.env.perception` (the observation) and
 :mod:`~explaindrive.env.violations` (what the ego did wrong).
@@ -27,6 +32,7 @@ from explaindrive.env.actions import (
     N_ACTIONS,
     STEP_LENGTH_S,
     least_stopping_need,
+    limited_speed,
     speed_change,
     stopping_need,
 )
@@ -99,6 +105,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self.scenario: ScenarioFiles = self._scenarios.current
         self.geometry: RouteGeometry
         self._crossing_lanes: dict[str, CrossingLane]
+        self._unregulated: frozenset[str]  # the route's junctions without junction logic
         self._load_geometry(self.scenario)
         if cfg.normalize_obs:
             low, high = S.normalize(S.STATE_LOW), S.normalize(S.STATE_HIGH)
@@ -144,8 +151,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     def action_masks(self) -> NDArray[np.bool_]:
         """The actions the run-time shield allows in the current true state (a copy, shape
         ``(7,)``): :func:`~explaindrive.env.safety.runtime_mask` of the raw observation
-        without sensor noise, with the active command."""
-        return runtime_mask(self._last_obs)
+        without sensor noise, with the active command (through the speed limiter when it is
+        on)."""
+        return runtime_mask(self._last_obs, self.config.speed_limiter)
 
     @property
     def _ego_length_m(self) -> float:
@@ -180,7 +188,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise
         self._entry = entry
         leaders = LeaderSensor(entry.min_gap_m, self._leader_lengths)
-        perception = Perception(self.geometry, self._crossing_lanes, leaders)
+        perception = Perception(
+            self.geometry, self._crossing_lanes, leaders, entry.length_m, self._unregulated
+        )
         self._ep = ep = Episode(
             command=opts.command,
             schedule=list(opts.command_schedule),
@@ -223,7 +233,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise RuntimeError("the episode is over; call reset() before step()")
         change = speed_change(action)
         cmd, prev_obs, prev_pos, seen = ep.command, self._last_obs, ep.pos_m, ep.seen
-        motion = self._advance(ep, change)
+        motion = self._advance(ep, change, float(prev_obs[S.V_LIM]))
         if self.config.ego_model != "agent":
             change = round(motion.speed_mps - ep.speed_mps)
         accel = motion.speed_mps - ep.speed_mps
@@ -231,7 +241,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         # violations are judged on what the ego saw before this step's observation
         assert seen is not None  # set by reset
         violations = ep.judge(self._sumo.api, prev_pos, ep.pos_m, seen.links,
-                              seen.crossings.in_lane)  # fmt: skip
+                              seen.crossings.in_lane, seen.yields.due_gap_m)  # fmt: skip
         ep.speed_mps, ep.accel_mps2 = motion.speed_mps, accel
         ep.apply_schedule()
         obs, leader, real = self._next_observation(motion, prev_obs)
@@ -290,9 +300,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         """The step limit cut a non-terminal episode."""
         return not terminated and self._episode().steps >= self.config.max_steps
 
-    def _advance(self, ep: Episode, change: int) -> Motion:
-        """Set the ego's speed (or let SUMO drive it), simulate one step, read the outcome."""
-        v_new = max(0.0, ep.speed_mps + change)
+    def _advance(self, ep: Episode, change: int, posted_limit_mps: float) -> Motion:
+        """Set the ego's speed (or let SUMO drive it), simulate one step, read the outcome.
+        With the speed limiter on, a rise that would pass ``posted_limit_mps`` (the limit the
+        agent observed) lands on it."""
+        limit = posted_limit_mps if self.config.speed_limiter else None
+        v_new = limited_speed(ep.speed_mps, change, limit)
         agent = self.config.ego_model == "agent"
         # a baseline: SUMO drives; STOP asks it to brake to a standstill within its decel limit
         sumo_speed = 0.0 if ep.command is Command.STOP else SUMO_DRIVES
@@ -353,6 +366,11 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         """The route's geometry and the ego lane's stretch on each of its crossings."""
         net = read_net(scenario.net_file)
         self.geometry = load_route_geometry(scenario.net_file, scenario.route_edges, net)
+        self._unregulated = frozenset(
+            j.node_id
+            for j in self.geometry.junctions
+            if net.getNode(j.node_id).getType() == "unregulated"
+        )
         self._crossing_lanes = crossing_lanes(
             scenario.net_file,
             {c.crossing_edge: c.approach_edge for c in self.geometry.crossings},

@@ -1,10 +1,14 @@
-"""The ego's violations in one step: collision, red-light run, pedestrian yield, speeding.
+"""The ego's violations in one step: collision, red-light run, pedestrian yield, right of
+way, speeding.
 
 Red lights and crossings are judged on what the ego saw before the step's observation: a
 violation is crossing a stop line during the step while the light was red, or while a
 pedestrian was in, or stepping into, the ego's lane on the crossing. A light is judged on
 the link the ego perceived (:func:`~explaindrive.env.perception.signal_links`): the stop
-line and signal index of its lane's link, as the observation reads them.
+line and signal index of its lane's link, as the observation reads them. A yield violation
+is crossing a yield line during the step while, before it, a foe with priority was within
+the gap of :mod:`explaindrive.env.right_of_way` (whether or not the ego could still stop
+there: a foe seen too late counts too).
 
 Each step has a site (:data:`~explaindrive.env.metrics.SITES`), where its violations are
 counted: a red-light run at its signal; a pedestrian-yield violation at its crossing's
@@ -21,7 +25,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from explaindrive.env.perception import CrossingSensor, SignalLink, link_colour
-from explaindrive.env.state import LightState
+from explaindrive.env.state import SENSOR_RANGE_M, LightState
 from explaindrive.sim.route import RouteCrossing, RouteGeometry
 from explaindrive.sim.scenario.files import EGO_ID
 
@@ -46,6 +50,7 @@ class Violations:
     red_light_run: bool
     ped_violation: bool
     site: str = "free_road"
+    yield_violation: bool = False
 
 
 class ViolationJudge:
@@ -67,11 +72,14 @@ class ViolationJudge:
         pos_m: float,
         links: tuple[SignalLink, ...],
         in_lane: dict[str, bool],
+        yield_due_m: float = SENSOR_RANGE_M,
     ) -> Violations:
         """The violations of a step that moved the ego's front from ``prev_pos_m`` to
-        ``pos_m`` (route positions [m]); ``links`` and ``in_lane`` are what the ego
-        perceived before the step (:class:`~explaindrive.env.perception.Percept`)."""
+        ``pos_m`` (route positions [m]); ``links``, ``in_lane`` and ``yield_due_m`` (the
+        nearest yield line in force, ``YieldReading.due_gap_m``) are what the ego perceived
+        before the step (:class:`~explaindrive.env.perception.Percept`)."""
         red = self.ran_red_light(api, links, pos_m - prev_pos_m)
+        yielded = not (yield_due_m < SENSOR_RANGE_M and 0.0 <= yield_due_m < pos_m - prev_pos_m)
         ped = self.crossed_occupied(api, prev_pos_m, pos_m, in_lane)
         if red:
             site = "signal"
@@ -80,7 +88,7 @@ class ViolationJudge:
             site = "signal" if crossing is not None and crossing.signalized else "crossing"
         else:
             site = self.site_at(pos_m)
-        return Violations(red, ped, site)
+        return Violations(red, ped, site, yield_violation=not yielded)
 
     def site_at(self, pos_m: float) -> str:
         """The site of route position ``pos_m`` (module docstring)."""

@@ -142,7 +142,7 @@ def _env_config(spec: EpisodeSpec, driver: Any) -> EnvConfig:
     """The env's config for an episode.
 
     Baselines see no observation noise; a network drives in the environment it was trained
-    in (its yellow-light rule).
+    in (its yellow-light rule, its speed limiter).
 
     Args:
         spec: the episode.
@@ -162,7 +162,9 @@ def _env_config(spec: EpisodeSpec, driver: Any) -> EnvConfig:
         **dict(spec.scenario),
     )
     if driver is not None:
-        config = config.replace(yellow_leader=driver.yellow_leader)
+        config = config.replace(
+            yellow_leader=driver.yellow_leader, speed_limiter=driver.speed_limiter
+        )
     return config
 
 

@@ -1,0 +1,242 @@
+"""Right of way: the rule's times worked out by hand, and on a priority crossroads built by
+netconvert, a yield line that is a virtual leader while a foe with priority approaches."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from explaindrive.agent.shield import shield
+from explaindrive.env import state as S
+from explaindrive.env.right_of_way import (
+    YIELD_MARGIN_S,
+    FoeMotion,
+    JunctionFoe,
+    YieldSensor,
+    arrival_time_s,
+    clear_time_s,
+    junction_of,
+    link_yields,
+    must_yield,
+)
+from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.sim.sumo_home import sumo_binary
+
+# A crossroads J of a priority road W-E (priority 3) and a minor road S-N (priority 1), each
+# one lane a way at 13.89 m/s; J is an unsignalised priority junction.
+NODES = """<nodes>
+  <node id="W" x="-300" y="0" type="priority"/>
+  <node id="J" x="0" y="0" type="priority"/>
+  <node id="E" x="300" y="0" type="priority"/>
+  <node id="S" x="0" y="-300" type="priority"/>
+  <node id="N" x="0" y="300" type="priority"/>
+</nodes>"""
+EDGES = """<edges>
+  <edge id="WJ" from="W" to="J" priority="3" numLanes="1" speed="13.89"/>
+  <edge id="JE" from="J" to="E" priority="3" numLanes="1" speed="13.89"/>
+  <edge id="EJ" from="E" to="J" priority="3" numLanes="1" speed="13.89"/>
+  <edge id="JW" from="J" to="W" priority="3" numLanes="1" speed="13.89"/>
+  <edge id="SJ" from="S" to="J" priority="1" numLanes="1" speed="13.89"/>
+  <edge id="JN" from="J" to="N" priority="1" numLanes="1" speed="13.89"/>
+  <edge id="NJ" from="N" to="J" priority="1" numLanes="1" speed="13.89"/>
+  <edge id="JS" from="J" to="S" priority="1" numLanes="1" speed="13.89"/>
+</edges>"""
+LINE_M = 292.8  # [m] netconvert's length of SJ: the yield line's route position
+NO_DEMAND = "<routes>\n</routes>\n"
+
+
+@pytest.fixture(scope="module")
+def crossroads(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The crossroads above, built by netconvert from plain XML, and a demand with no car
+    (the foe is added by the test)."""
+    folder = tmp_path_factory.mktemp("crossroads")
+    (folder / "n.nod.xml").write_text(NODES)
+    (folder / "e.edg.xml").write_text(EDGES)
+    (folder / "empty.rou.xml").write_text(NO_DEMAND)
+    out = folder / "crossroads.net.xml"
+    subprocess.run([sumo_binary("netconvert"), "--node-files", str(folder / "n.nod.xml"),
+                    "--edge-files", str(folder / "e.edg.xml"), "--no-turnarounds", "true",
+                    "-o", str(out)], check=True, capture_output=True)  # fmt: skip
+    return out, folder / "empty.rou.xml"
+
+
+def test_the_ego_clears_accelerating_hardest_up_to_the_limit() -> None:
+    # from a standstill: 3, 6, 9, 12 m/s -> 3, 9, 18, 30 m: 19 m take 4 steps
+    assert clear_time_s(19.0, 0.0, 13.89) == 4.0
+    # at 13 m/s under 13.89: 13.89 m a step, 30 m take 3 steps
+    assert clear_time_s(30.0, 13.0, 13.89) == 3.0
+    assert clear_time_s(0.0, 0.0, 13.89) == 0.0
+    assert clear_time_s(5.0, 0.0, 0.0) == math.inf  # a zero limit never clears
+
+
+def test_a_foe_arrives_as_early_as_its_acceleration_allows() -> None:
+    # 10 m/s, 2 m/s^2 up to 14 m/s: 2 s and 24 m to 14 m/s, then 76 m at 14 m/s in 5.43 s
+    assert arrival_time_s(100.0, 10.0, 2.0, 14.0) == pytest.approx(2.0 + 76.0 / 14.0)
+    assert arrival_time_s(9.0, 0.0, 2.0, 14.0) == pytest.approx(3.0)  # 9 = 2 t^2 / 2
+    assert arrival_time_s(50.0, 10.0, 0.0, 14.0) == pytest.approx(5.0)  # no acceleration
+    assert arrival_time_s(50.0, 0.0, 0.0, 14.0) == math.inf  # standing, cannot start
+    assert arrival_time_s(-1.0, 0.0, 2.0, 14.0) == 0.0  # already in the conflict
+
+
+def test_link_states_and_junction_ids() -> None:
+    # priority, then open but yielding, then the light's to judge (red, red-yellow, yellow)
+    assert [link_yields(c) for c in "GMOgmsw=oZruy"] == [False] * 3 + [True] * 7 + [False] * 3
+    assert junction_of(":J_7_0") == "J"
+    assert junction_of(":cluster_J1_J2_12_0") == "cluster_J1_J2"
+    assert junction_of("SJ_0") == ""
+
+
+def test_foes_are_looked_for_up_to_the_last_yielding_link_before_an_unregulated_one() -> None:
+    lines = [("A", 50.0), ("B", 120.0), ("U", 150.0), ("C", 180.0)]
+    sensor = YieldSensor(lines, 5.0, unregulated=frozenset({"U"}))
+    links = [("x", True, True, False, f":{j}_0_0", state, "s", length)
+             for j, state, length in (("A", "M", 10.0), ("B", "m", 12.0), ("U", "M", 9.0),
+                                      ("C", "m", 11.0))]  # fmt: skip
+    # from 20 m: B's line 100 m ahead and its 12 m link, and a metre; C lies beyond U
+    assert sensor.horizon(links, 20.0) == ({"B": "m"}, 100.0 + 12.0 + 1.0)
+    # from 160 m, past U: C's line 20 m ahead
+    assert sensor.horizon(links, 160.0) == ({"C": "m"}, 20.0 + 11.0 + 1.0)
+    assert sensor.horizon(links[:1], 20.0) == ({}, 0.0)  # nothing yields: no look-up
+
+
+def _foe(foe_dist_m: float, foe_exit_m: float, ego_exit_m: float = 14.0) -> JunctionFoe:
+    return JunctionFoe("foe", ego_exit_m - 3.2, foe_dist_m, ego_exit_m, foe_exit_m,
+                       ":J_7_0", ":J_10_0", True, False)  # fmt: skip
+
+
+def test_the_ego_yields_when_the_foe_arrives_before_it_has_cleared_plus_the_margin() -> None:
+    cruising = FoeMotion(13.89, 2.6, 13.89, 5.0)
+    # the ego stands 5 m before the line: its back leaves the conflict 14 + 5 = 19 m on,
+    # in 4 steps; the foe at 13.89 m/s arrives in d / 13.89 s
+    ego = (0.0, 13.89, 5.0)
+    yield_within_s = 4.0 + YIELD_MARGIN_S  # 6 s
+    near = _foe(13.89 * yield_within_s - 1.0, 13.89 * yield_within_s + 2.2)
+    far = _foe(13.89 * yield_within_s + 1.0, 13.89 * yield_within_s + 4.2)
+    assert must_yield("m", near, cruising, *ego)
+    assert not must_yield("m", far, cruising, *ego)
+    assert not must_yield("M", near, cruising, *ego)  # the ego's link has priority
+    assert not must_yield("G", near, cruising, *ego)
+    assert must_yield("g", near, cruising, *ego)  # a permissive turn at a light
+    passed = _foe(-9.0, -4.0)  # its front 4 m past the conflict, its back 1 m in it
+    gone = _foe(-11.0, -6.0)  # its back 1 m past it
+    assert must_yield("m", passed, cruising, *ego)
+    assert not must_yield("m", gone, cruising, *ego)
+    at_red = FoeMotion(13.89, 2.6, 13.89, 5.0, link_state="r")
+    assert not must_yield("m", near, at_red, *ego)
+    not_responding = near._replace(ego_responds=False)
+    assert not must_yield("m", not_responding, cruising, *ego)
+
+
+def _drive(env: UrbanDriveEnv, foe_at_step: int, steps: int = 70) -> list[dict[str, float]]:
+    """Drive the ego by the shield, asking for the fastest change (a SUMO baseline ego drives
+    itself); a foe enters the priority road at its start, at 13.89 m/s, after
+    ``foe_at_step`` steps. One row a step; the last one's ``t`` is the arrival time [s]."""
+    obs, _ = env.reset(seed=0)
+    api = env.sumo
+    api.route.add("major", ["WJ", "JE"])
+    rows = []
+    for i in range(steps):
+        if i == foe_at_step:
+            api.vehicle.add("foe", "major", departPos="0", departSpeed="13.89")
+        seen = env._episode().seen
+        assert seen is not None
+        foe_road = api.vehicle.getRoadID("foe") if "foe" in api.vehicle.getIDList() else ""
+        rows.append({"pos": env.route_pos_m, "v": float(obs[S.V_EGO]),
+                     "lead": float(obs[S.D_LEAD]), "dv": float(obs[S.DV]),
+                     "yield": seen.yields.leader_gap_m, "foe_on_je": foe_road == "JE",
+                     "foe_gone": foe_road in ("JE", ""),
+                     "yield_violation": False})  # fmt: skip
+        decision = shield(obs, np.arange(7, dtype=np.float64))  # the fastest safe change
+        obs, _r, terminated, truncated, info = env.step(decision.action)
+        assert not info["collision"]
+        rows[-1]["yield_violation"] = info["yield_violation"]
+        if terminated or truncated:
+            break
+    assert info["arrived"]
+    rows[-1]["t"] = info["time_s"]
+    return rows
+
+
+@pytest.mark.slow
+def test_a_yield_line_holds_the_ego_while_a_foe_with_priority_approaches(
+    make_env: Callable[..., UrbanDriveEnv], crossroads: tuple[Path, Path]
+) -> None:
+    net, demand = crossroads
+    env = make_env(net_file=net, route=("SJ", "JN"), demand_file=demand, warmup_s=0,
+                   max_steps=70)  # fmt: skip
+    # the ego reaches the line after about 23 s; the foe, entering after 3 s, after 24 s
+    rows = _drive(env, foe_at_step=3)
+    held = [r for r in rows if r["yield"] < S.SENSOR_RANGE_M]
+    assert held, "the yield line was never a leader"
+    for r in held:  # a standing virtual leader at the line: gap to the line, dv = own speed
+        assert r["yield"] == pytest.approx(LINE_M - r["pos"], abs=1e-6)
+        assert r["lead"] == pytest.approx(LINE_M - r["pos"], abs=1e-3)
+        assert r["dv"] == pytest.approx(r["v"], abs=1e-6)
+    # the ego's front crosses the line only once the foe has left the junction
+    first_past = next(r for r in rows if r["pos"] > LINE_M)
+    assert first_past["foe_on_je"]
+    assert min(LINE_M - r["pos"] for r in rows if r["pos"] <= LINE_M) > 0.0
+    # once the foe has passed, the line is no leader
+    assert all(r["yield"] == S.SENSOR_RANGE_M for r in rows if r["foe_gone"])
+    assert not any(r["yield_violation"] for r in rows)
+
+
+@pytest.mark.slow
+def test_entering_in_front_of_the_foe_is_a_yield_violation(
+    make_env: Callable[..., UrbanDriveEnv], crossroads: tuple[Path, Path]
+) -> None:
+    net, demand = crossroads
+    env = make_env(net_file=net, route=("SJ", "JN"), demand_file=demand, warmup_s=0,
+                   max_steps=40)  # fmt: skip
+    obs, _ = env.reset(seed=0)
+    env.sumo.route.add("major", ["WJ", "JE"])
+    flagged = []
+    for i in range(40):
+        if i == 3:  # as above: the foe reaches J about 24 s in
+            env.sumo.vehicle.add("foe", "major", departPos="0", departSpeed="13.89")
+        # no shield: 3, 6, 9, 12 m/s, then 13 m/s, whatever lies ahead
+        before = env.route_pos_m
+        change = int(np.clip(13 - round(float(obs[S.V_EGO])), -3, 3))
+        obs, _r, terminated, truncated, info = env.step(change + 3)
+        if info["yield_violation"]:
+            flagged.append((before, env.route_pos_m))
+        if terminated or truncated:
+            break
+    # 35.1 m after 4 steps, then 13 m a step: the line at 292.8 m is crossed once, in the
+    # step from 282.1 m to 295.1 m, 20 steps later
+    assert flagged == [(pytest.approx(282.1), pytest.approx(295.1))]
+
+
+@pytest.mark.slow
+def test_a_far_foe_makes_no_yield_line(
+    make_env: Callable[..., UrbanDriveEnv], crossroads: tuple[Path, Path]
+) -> None:
+    net, demand = crossroads
+    env = make_env(net_file=net, route=("SJ", "JN"), demand_file=demand, warmup_s=0,
+                   max_steps=70)  # fmt: skip
+    # entering after 14 s, the foe reaches J about 35 s in, 10 s after the ego has crossed
+    rows = _drive(env, foe_at_step=14)
+    assert all(r["yield"] == S.SENSOR_RANGE_M for r in rows)
+    assert all(r["lead"] == S.SENSOR_RANGE_M for r in rows)
+
+
+@pytest.mark.slow
+def test_the_shielded_ego_yields_as_sumo_krauss_does(
+    make_env: Callable[..., UrbanDriveEnv], crossroads: tuple[Path, Path]
+) -> None:
+    net, demand = crossroads
+    times = {}
+    for model in ("krauss", "agent"):
+        env = make_env(net_file=net, route=("SJ", "JN"), demand_file=demand, warmup_s=0,
+                       max_steps=70, ego_model=model)  # fmt: skip
+        rows = _drive(env, foe_at_step=3)
+        assert next(r for r in rows if r["pos"] > LINE_M)["foe_on_je"]  # after the foe
+        times[model] = rows[-1]["t"]
+    # measured: both arrive 52 s after entering (48 s with the rule off: the ego crosses
+    # before the foe, which brakes for it)
+    assert times["agent"] == pytest.approx(times["krauss"], abs=2.0)
