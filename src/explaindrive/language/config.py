@@ -92,6 +92,11 @@ class OpenAIConfig(LaxModel):
     decision_temperature: float = Field(default=0.0, ge=0.0, le=2.0)
     explain_temperature: float = Field(default=0.2, ge=0.0, le=2.0)
     max_tokens: int = Field(default=120, ge=8)
+    grammar: bool = False
+    """Send llama.cpp's ``grammar`` (GBNF) with the LLM-1 and LLM-2 calls, so that the model
+    can answer only with a template question or "not a request" (LLM-1) and with one of the
+    two tags (LLM-2); LLM-3 stays free text. For llama.cpp servers (the local server of
+    ``backends/local_server.py``); other endpoints may refuse the unknown field."""
     trust_embedded_from: float = Field(default=0.8, ge=0.0, le=1.0)
     """The embedded reading's probability from which a different reading of the model does
     not replace it (:mod:`explaindrive.language.intent.agreement`): 0 leaves every reading to the

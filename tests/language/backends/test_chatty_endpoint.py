@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 
 runner = CliRunner()
 TEMPLATES = {format_confirmation(c) for c in Command} | {REPHRASE_MESSAGE}
-SICK = "I'm feeling a bit sick"  # the embedded reading: comfort
+SICK = "Could you drive more gently, I feel sick"  # the embedded reading: comfort
 RED = StateRecord.model_validate(
     {
         "request": "fast",
@@ -104,11 +104,11 @@ def test_a_remote_stop_wins_over_an_unsure_reading_only(
 ) -> None:
     it = OpenAIIntentInterpreter(client(openai_server), interpreter)
     openai_server.script = [("ok", "Sure. Shall I pull over here?")]
-    unsure = "I guess we are nearly there."  # embedded: none at 0.80 (0.7988)
+    unsure = "Hmm, this looks about right."  # embedded: none at 0.75 (0.7452), under 0.8
     r = it.interpret(unsure)
     assert (r.intent, r.rule) == (Command.STOP, "stop-remote")
     assert r.confirmation == "You want me to stop, is this correct?"
-    r = it.interpret(SICK)  # embedded: comfort at 0.99
+    r = it.interpret(SICK)  # embedded: comfort, sure
     assert (r.intent, r.rule, r.overruled) == (Command.COMFORT, "local-sure", True)
 
 
@@ -138,8 +138,8 @@ def test_an_over_eager_decider_explains_no_more_than_the_rules(
     remote = [eager.decide(r) for r in ride]
     local = [rules.decide(r) for r in ride]
     assert [d.explain for d in remote] == [d.explain for d in local]
-    assert sum(d.explain for d in remote) == 73  # the set's records to explain
-    assert sum(d.vetoed for d in remote) == len(ride) - 73
+    assert sum(d.explain for d in remote) == 82  # the set's records to explain
+    assert sum(d.vetoed for d in remote) == len(ride) - 82
     # an empty road: every request and action, never an explanation
     empty = [
         StateRecord.model_validate(

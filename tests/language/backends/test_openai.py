@@ -164,3 +164,21 @@ def test_loading_the_openai_stack_loads_the_offline_fallback() -> None:
     assert not reader.loaded  # lazy until loaded
     stack.load()  # a ride calls this before it starts
     assert reader.loaded
+
+
+def test_grammar_is_sent_to_llm1_and_llm2_only_when_asked(openai_server) -> None:  # type: ignore[no-untyped-def]
+    from explaindrive.language.backends.openai import DECISION_GRAMMAR, INTENT_GRAMMAR
+
+    assert DECISION_GRAMMAR == 'root ::= "[EXPLAIN]" | "[NO EXPLANATION NEEDED]"'
+    on = ChatClient(
+        OpenAIConfig(base_url=openai_server.base_url, api_key="t", timeout_s=1.0, grammar=True)
+    )
+    openai_server.script = [("ok", "[EXPLAIN]")]
+    on.complete("s", "u", 0.0, DECISION_GRAMMAR)
+    on.complete("s", "u", 0.0)  # LLM-3: free text
+    client(openai_server).complete("s", "u", 0.0, INTENT_GRAMMAR)  # grammar off (default)
+    sent = [body.get("grammar") for body in openai_server.requests]
+    assert sent == [DECISION_GRAMMAR, None, None]
+    assert (
+        '"drive more carefully"' in INTENT_GRAMMAR and '"NOT A DRIVING REQUEST"' in INTENT_GRAMMAR
+    )

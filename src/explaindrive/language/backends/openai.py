@@ -93,6 +93,14 @@ asked for comfort, smooth acceleration/braking).
 the most safety-critical one.
 Output only the tag. Do not include any justification or text besides the
 tag."""  # noqa: E501
+INTENT_GRAMMAR = (
+    'root ::= "You want me to " ("drive faster" | "drive more carefully" | "stop") '
+    f'", is this correct?" | "{NOT_A_REQUEST}"'
+)
+"""GBNF of LLM-1's reply (sent with ``openai.grammar``): a template question or
+:data:`~explaindrive.language.backends.replies.NOT_A_REQUEST`."""
+DECISION_GRAMMAR = f'root ::= "{EXPLAIN_TAG}" | "{NO_EXPLANATION_TAG}"'
+"""GBNF of LLM-2's reply (sent with ``openai.grammar``): one of the two tags."""
 EXPLAIN_PROMPT = """You are an AI assistant inside an autonomous taxi. Your job is to explain
 to the passenger why the vehicle’s action seems to contradict their request.
 When that happens, briefly explain the most safety-relevant nearby reason
@@ -136,8 +144,11 @@ class ChatClient:
             http_client=deadline.http_client(config.timeout_s),
         )
 
-    def complete(self, system: str, user: str, temperature: float) -> str:
+    def complete(
+        self, system: str, user: str, temperature: float, grammar: str | None = None
+    ) -> str:
         """One chat completion within ``config.timeout_s`` in total; returns the reply text.
+        ``grammar`` (GBNF) is sent when ``config.grammar`` is on.
 
         The deadline covers connecting, sending, reading and the retries
         (``config.max_retries``, for connection errors, HTTP 429 and 5xx).
@@ -153,7 +164,7 @@ class ChatClient:
         for attempt in range(self.config.max_retries + 1):
             try:
                 with deadline.until(end):
-                    resp = self._create(system, user, temperature)
+                    resp = self._create(system, user, temperature, grammar)
                 break
             except openai.APITimeoutError as exc:
                 raise DeadlineExceededError(
@@ -164,12 +175,14 @@ class ChatClient:
                     raise
         return self._reply_text(resp)
 
-    def _create(self, system: str, user: str, temperature: float) -> Any:
+    def _create(self, system: str, user: str, temperature: float, grammar: str | None) -> Any:
+        extra = {"grammar": grammar} if grammar is not None and self.config.grammar else None
         return self._client.chat.completions.create(
             model=self.config.model,
             messages=[{"role": "system", "content": system}, {"role": "user", "content": user}],
             temperature=temperature,
             max_tokens=self.config.max_tokens,
+            extra_body=extra,
         )
 
     def _reply_text(self, resp: Any) -> str:
@@ -234,7 +247,9 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             )
         raw: str | None = None
         try:
-            raw = self.client.complete(INTENT_PROMPT, text, self.client.config.intent_temperature)
+            raw = self.client.complete(
+                INTENT_PROMPT, text, self.client.config.intent_temperature, INTENT_GRAMMAR
+            )
             reading = read_confirmation(raw)
             if not reading.ok:
                 raise BackendReplyError(f"reply not read: {reading.problem}: {raw[:120]!r}")
@@ -303,6 +318,7 @@ class OpenAIDecider(ExplanationDecider):
                 DECISION_PROMPT,
                 situation_message(record, cutoff),
                 self.client.config.decision_temperature,
+                DECISION_GRAMMAR,
             )
             explain = read_decision_tag(raw)
             if explain is None:
