@@ -27,8 +27,9 @@ def test_the_fine_tuned_encoder_gives_unit_embeddings(
 
 def test_default_ride_lines(interpreter: EmbeddedIntentInterpreter) -> None:
     said = [line.say for line in load_script(default_script_path())]
-    got = [interpreter.interpret(text).intent for text in said if text is not None]
-    assert got == [Command.FAST, Command.STOP, Command.COMFORT]
+    got = [interpreter.interpret(text) for text in said if text is not None]
+    assert [r.intent for r in got] == [Command.FAST, None, Command.STOP, Command.COMFORT]
+    assert [r.reading for r in got] == ["fast", "why", "stop", "comfort"]
 
 
 def test_on_the_calibration_pool_stops_are_heard_and_few_other_lines_are_a_stop(
@@ -43,6 +44,6 @@ def test_on_the_calibration_pool_stops_are_heard_and_few_other_lines_are_a_stop(
         if e.label not in ("fast", "comfort", "stop") and r.reading == "stop"
     ]
     negatives = sum(e.label not in ("fast", "comfort", "stop") for e in pool)
-    # the calibration chose the STOP threshold there: 141 of 142 heard, 23 of 4,003 false
-    assert len(stops) > 100 and np.mean(stops) >= 0.99
-    assert negatives > 3000 and len(false_stops) <= 0.01 * negatives
+    # the calibration chose the STOP threshold there: 143 of 146 heard, 4 of 4,011 false
+    assert len(stops) > 100 and np.mean(stops) >= 0.97
+    assert negatives > 3000 and len(false_stops) <= 0.002 * negatives
