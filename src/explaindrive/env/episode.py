@@ -84,7 +84,12 @@ class StepRecord:
 
     Attributes:
         command: the command the action was taken under.
-        change: the speed change applied [m/s] (SUMO's own for the baselines).
+        change: the speed change applied [m/s]: the action's, or with the speed limiter
+            on the one it let through (:func:`~explaindrive.env.actions.limited_change`:
+            +1 at 13 m/s under a 13.89 m/s limit applies +0.89); SUMO's own, rounded, for
+            the baselines. The reward reads it only under STOP, for its sign, which the
+            limiter never changes (a rise it cuts stays >= 0); the ride-quality figures and
+            the reward's braking terms read ``accel``, the change as driven.
         accel: the ego's acceleration over the step [m/s^2].
         jerk: its change from the previous step's [m/s^3].
         motion: what the simulation did with the ego.
@@ -97,7 +102,7 @@ class StepRecord:
     """
 
     command: Command
-    change: int
+    change: float
     accel: float
     jerk: float
     motion: Motion

@@ -300,7 +300,7 @@ def collision_reward(collided: bool) -> float:
     return -R_CRITICAL if collided else 0.0
 
 
-def stop_reward(speed_mps: float, speed_change_mps: int) -> float:
+def stop_reward(speed_mps: float, speed_change_mps: float) -> float:
     """R2: r_respect at standstill, -r_critical when keeping or raising speed, else 0."""
     if speed_mps <= 0.0:
         return R_RESPECT
@@ -314,7 +314,7 @@ class StepFeatures:
     """Everything a reward needs about one step."""
 
     speed_mps: float  # ego speed after the step
-    speed_change_mps: int  # the action's speed change
+    speed_change_mps: float  # the speed change applied (through the speed limiter, if on)
     limit_mps: float  # posted limit the agent observed
     ttc_s: float  # w.r.t. the effective (real or virtual) leader
     headway_s: float  # w.r.t. the effective leader
