@@ -86,8 +86,8 @@ def test_the_masks_read_the_speed_limiter_when_it_is_on() -> None:
     assert np.array_equal(mask, training_mask(limited, True, True))
     # an empty road at 13 m/s (EMPTY's 12 m/s moved by +1): +1 is over the limit (14 m/s)
     # without the limiter and lands on 13.89 with it
-    free_13 = (limited[:, S.V_EGO] == 13.0) & (limited[:, S.D_LEAD] >= R) & (
-        limited[:, S.TLS] == 0.0
+    free_13 = (
+        (limited[:, S.V_EGO] == 13.0) & (limited[:, S.D_LEAD] >= R) & (limited[:, S.TLS] == 0.0)
     )
     assert free_13.any()
     assert not plain_mask[free_13, 4].any() and mask[free_13, 4].all()

@@ -149,7 +149,9 @@ def test_learner_learns_a_contextual_bandit() -> None:
     assert learner.updates == 300
 
 
-@pytest.mark.parametrize(("limit_margin", "speed_limiter"), [(None, False), (5.0, False), (5.0, True)])
+@pytest.mark.parametrize(
+    ("limit_margin", "speed_limiter"), [(None, False), (5.0, False), (5.0, True)]
+)
 def test_actions_over_the_limit_have_their_own_margin(
     limit_margin: float | None, speed_limiter: bool
 ) -> None:

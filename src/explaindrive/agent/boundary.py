@@ -21,9 +21,10 @@ yields one synthetic observation:
   its leader.
 
 The masks of these rows are computed by the same rule (through the speed limiter when the
-config's ``speed_limiter`` is on, as the masks of the episodes' rows are); the learner pushes their unsafe
-actions below their best safe one (:func:`~explaindrive.agent.targets.unsafe_action_loss`),
-weighted by ``boundary_weight``. Nothing else is learned from them: they have no reward.
+config's ``speed_limiter`` is on, as the masks of the episodes' rows are); the learner
+pushes their unsafe actions below their best safe one
+(:func:`~explaindrive.agent.targets.unsafe_action_loss`), weighted by ``boundary_weight``.
+Nothing else is learned from them: they have no reward.
 
 With ``boundary_noise`` the network sees each synthetic row through observation noise
 (:func:`~explaindrive.env.noise.noisy_rows`) drawn as the episodes draw theirs: a share

@@ -125,7 +125,7 @@ class StepRecord:
             ttc_s=time_to_collision(leader.gap_m, v - leader.speed_mps) if leader else math.inf,
             headway_s=time_headway(leader.gap_m, leader.length_m, v) if leader else math.inf,
             jerk_mps3=self.jerk,
-            violation=self.violations.red_light_run or self.violations.ped_violation,
+            violation=self.violations.any,
             stop_reason=stop_reason,
             collided=self.motion.collided,
             real_headway_s=time_headway(real.gap_m, real.length_m, v) if real else math.inf,

@@ -32,8 +32,8 @@ from explaindrive.env.actions import (
     N_ACTIONS,
     STEP_LENGTH_S,
     least_stopping_need,
-    limited_speed,
     limited_change,
+    limited_speed,
     speed_change,
     stopping_need,
 )
