@@ -123,10 +123,10 @@ def test_the_family_draws_priority_junctions_the_ego_yields_at(end: str, tmp_pat
     plain = {j.node_id for j in geometry.junctions if not (j.signalized or j.crossing)}
     yields = [j for j, state in links if link_yields(state) and j in plain]
     assert yields == (["Z1"] if drawn else [])
-    # its side road carries a flow each way at the drawn rate (250 veh/h at the high end)
+    # its side road carries a flow each way at the drawn rate (120 veh/h at the high end)
     assert files.plan is not None
     flows = [(f.nodes, f.veh_per_hour) for f in files.plan.flows if f.id.startswith("z1_")]
-    assert flows == ([(("Z1N", "Z1", "Z1S"), 250.0), (("Z1S", "Z1", "Z1N"), 250.0)] if drawn
+    assert flows == ([(("Z1N", "Z1", "Z1S"), 120.0), (("Z1S", "Z1", "Z1N"), 120.0)] if drawn
                      else [])  # fmt: skip
 
 

@@ -46,7 +46,7 @@ RANGES: dict[str, tuple[float, float, float]] = {
     "j2_turn_north": (50, 250, 25),
     "j2_cross": (20, 120, 10),
     "priority_junction": (0, 1, 1),  # 0: no, 1: Z1 is a priority junction the ego yields at
-    "z1_cross": (50, 250, 25),
+    "z1_cross": (20, 120, 10),  # the main road yields to it: more jams it at high levels
 }
 _SIGNAL_KEYS = ("cycle_s", "main_share", "yellow_s", "all_red_s")
 _DEMAND_KEYS = ("main_east", "main_west", "j1_cross", "j2_turn_south", "j2_turn_north",
