@@ -78,6 +78,21 @@ def test_the_masks_are_the_rules_and_many_rows_sit_on_the_boundary() -> None:
     assert unsafe_share[1] > 0.15 and unsafe_share[6] < 0.95
 
 
+def test_the_masks_read_the_speed_limiter_when_it_is_on() -> None:
+    obs = np.asarray([FOLLOWING, RED_AHEAD, EMPTY] * 500, dtype=np.float32)
+    plain, plain_mask = boundary_batch(obs, np.random.default_rng(5), True)
+    limited, mask = boundary_batch(obs, np.random.default_rng(5), True, speed_limiter=True)
+    np.testing.assert_array_equal(limited, plain)  # the same rows, drawn the same way
+    assert np.array_equal(mask, training_mask(limited, True, True))
+    # an empty road at 13 m/s (EMPTY's 12 m/s moved by +1): +1 is over the limit (14 m/s)
+    # without the limiter and lands on 13.89 with it
+    free_13 = (
+        (limited[:, S.V_EGO] == 13.0) & (limited[:, S.D_LEAD] >= R) & (limited[:, S.TLS] == 0.0)
+    )
+    assert free_13.any()
+    assert not plain_mask[free_13, 4].any() and mask[free_13, 4].all()
+
+
 def test_noisy_rows_keep_the_masks_of_the_rows_without_noise() -> None:
     obs = np.asarray([FOLLOWING, RED_AHEAD, EMPTY] * 2000, dtype=np.float32)
     clean, clean_mask = boundary_batch(obs, np.random.default_rng(4), True)

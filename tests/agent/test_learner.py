@@ -149,22 +149,30 @@ def test_learner_learns_a_contextual_bandit() -> None:
     assert learner.updates == 300
 
 
-@pytest.mark.parametrize("limit_margin", [None, 5.0])
-def test_actions_over_the_limit_have_their_own_margin(limit_margin: float | None) -> None:
+@pytest.mark.parametrize(
+    ("limit_margin", "speed_limiter"), [(None, False), (5.0, False), (5.0, True)]
+)
+def test_actions_over_the_limit_have_their_own_margin(
+    limit_margin: float | None, speed_limiter: bool
+) -> None:
     # Comfort at 12 m/s in the 13.89 m/s zone, a red line 35 m ahead: -3..0 are safe, +1
-    # (13 m/s) is unsafe for the light alone (standing after it needs 37 m), +2 and +3 also
-    # exceed the limit. The loss is the summed squared excess of the unsafe values over
-    # (best safe - margin), by hand from the values before the update: 30 for +1 and
-    # limit_margin (30 unless set) for +2 and +3.
-    config = PASSENGER.replace(loss="mse", limit_margin=limit_margin)
+    # (13 m/s) is unsafe for the light alone (standing after it needs 13 + 22 + 2 = 37 m),
+    # +2 and +3 also exceed the limit without the limiter (14 and 15 m/s); with it they
+    # land on 13.89 m/s (standing then needs 13.89 + 25.56 + 2 = 41.45 m) and exceed
+    # nothing. The loss is the summed squared excess of the unsafe values over
+    # (best safe - margin), by hand from the values before the update: 30 for +1, and for
+    # +2 and +3 limit_margin (30 unless set) without the limiter, 30 with it.
+    config = PASSENGER.replace(loss="mse", limit_margin=limit_margin, speed_limiter=speed_limiter)
     learner = D3QNLearner(config)
     row = np.asarray([[1.0, 12.0, 13.89, 35.0, 12.0, 35.0, 2.0, 200.0]], dtype=np.float32)
-    mask = training_mask(row, True)
+    mask = training_mask(row, True, speed_limiter)
     assert mask[0].tolist() == [True] * 4 + [False] * 3
-    assert limit_mask(row)[0].tolist() == [True] * 5 + [False] * 2
+    over = [False] * 5 + [not speed_limiter] * 2
+    assert (~limit_mask(row, speed_limiter))[0].tolist() == over
     q = learner.q_values(row)[0].astype(np.float64)
     best = q[:4].max()
-    floors = best - np.array([30.0, limit_margin or 30.0, limit_margin or 30.0])
+    over_margin = 30.0 if speed_limiter else (limit_margin or 30.0)
+    floors = best - np.array([30.0, over_margin, over_margin])
     expected = float(np.sum(np.maximum(q[4:] - floors, 0.0) ** 2))
     batch = ReplayBatch(
         obs=row, actions=np.array([0]), rewards=np.zeros(1, np.float32), next_obs=row,
@@ -172,6 +180,20 @@ def test_actions_over_the_limit_have_their_own_margin(limit_margin: float | None
         mask=mask, next_mask=mask,
     )  # fmt: skip
     assert learner.update(batch, 0).unsafe_loss == pytest.approx(expected, rel=1e-4)
+
+
+def test_the_limit_margin_reads_the_limiter() -> None:
+    # +1 at 13 m/s under 13.89: 14 m/s without the limiter (over), 13.89 with it (not over);
+    # at 15 m/s the limiter never brakes: -1 leaves 14, 0..+3 keep 15 (over), -3 and -2 not
+    at_13 = np.asarray([[0.0, 13.0, 13.89, 200.0, 0.0, 200.0, 0.0, 200.0]], dtype=np.float32)
+    assert limit_mask(at_13)[0].tolist() == [True] * 4 + [False] * 3
+    assert limit_mask(at_13, speed_limiter=True)[0].tolist() == [True] * 7
+    at_15 = at_13.copy()
+    at_15[0, 1] = 15.0
+    assert limit_mask(at_15, speed_limiter=True)[0].tolist() == [True] * 2 + [False] * 5
+    margins = D3QNLearner(PASSENGER.replace(limit_margin=5.0))._margins(np.vstack([at_13, at_15]))
+    assert isinstance(margins, torch.Tensor)
+    assert margins.tolist() == [[30.0] * 7, [30.0] * 2 + [5.0] * 5]
 
 
 def test_limit_margin_needs_unsafe_margin() -> None:

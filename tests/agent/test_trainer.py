@@ -315,9 +315,9 @@ def test_boundary_rows_are_seen_through_noise_when_asked(
     seen: list[tuple[object, ...]] = []
     real = trainer_module.boundary_batch
 
-    def spy(*args: object) -> object:
+    def spy(*args: object, **kwargs: object) -> object:
         seen.append(args[3:])
-        return real(*args)  # type: ignore[arg-type]
+        return real(*args, **kwargs)  # type: ignore[arg-type]
 
     monkeypatch.setattr(trainer_module, "boundary_batch", spy)
     config = tiny(episodes=4, boundary_weight=1.0, obs_noise_max=[2.0, 0.6], noisy_share=0.5,

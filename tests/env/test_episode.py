@@ -49,6 +49,25 @@ def test_features_are_taken_to_the_effective_leader() -> None:
     assert step(None, None).features().ttc_s == math.inf
 
 
+@pytest.mark.parametrize(
+    ("violations", "traffic"),
+    [
+        (Violations(False, False, "yield_junction", yield_violation=True), -10.0),
+        (Violations(False, True, "crossing"), -10.0),
+        (Violations(False, False, "yield_junction"), 0.0),
+    ],
+)
+def test_a_yield_violation_is_charged_as_the_other_violations(
+    violations: Violations, traffic: float
+) -> None:
+    motion = Motion(10.0, collided=False, arrived=False, ego=None)
+    rec = StepRecord(Command.FAST, 1, 1.0, -0.5, motion, None, None, 13.89, violations)
+    f = rec.features()
+    assert f.violation is (traffic < 0.0)
+    # R_traffic: -r_unsafe (10) for a violation while moving, 0 otherwise
+    assert reward_terms(Command.FAST, f, RECIPES["passenger"]).traffic == traffic
+
+
 def test_the_info_reports_the_step() -> None:
     ep = episode([])
     ep.steps, ep.pos_m = 4, 52.0

@@ -19,6 +19,7 @@ def info(
     collision=False,
     red=False,
     ped=False,
+    yield_=False,
     speeding=False,
     arrived=False,
     site="free_road",
@@ -34,6 +35,7 @@ def info(
         "collision": collision,
         "red_light_run": red,
         "ped_violation": ped,
+        "yield_violation": yield_,
         "speeding": speeding,
         "site": site,
         "arrived": arrived,
@@ -72,14 +74,18 @@ def test_violations_are_split_by_site() -> None:
     m.update(info(6.0, speeding=True, site="signal"))  # still speeding inside the junction
     m.update(info(5.0, ped=True, site="crossing"))
     m.update(info(5.0, collision=True, site="yield_junction"))
+    m.update(info(7.0, yield_=True, site="yield_junction"))  # crossed before a foe
     m.update(info(15.0, speeding=True))
     m.update(info(12.0, site="signal"))  # a site with nothing wrong counts nothing
     r = m.result()
-    assert (r.collisions, r.red_light_runs, r.ped_violations, r.speeding_steps) == (1, 1, 1, 3)
-    zero = {"collisions": 0, "red_light_runs": 0, "ped_violations": 0, "speeding_steps": 0}
+    assert (r.collisions, r.red_light_runs, r.ped_violations, r.yield_violations,
+            r.speeding_steps) == (1, 1, 1, 1, 3)  # fmt: skip
+    assert r.violations == 7  # 1 + 1 + 1 + 1 + 3
+    zero = {"collisions": 0, "red_light_runs": 0, "ped_violations": 0, "yield_violations": 0,
+            "speeding_steps": 0}  # fmt: skip
     assert r.violations_by_site == {
         "signal": {**zero, "red_light_runs": 1, "speeding_steps": 2},
-        "yield_junction": {**zero, "collisions": 1},
+        "yield_junction": {**zero, "collisions": 1, "yield_violations": 1},
         "crossing": {**zero, "ped_violations": 1},
         "free_road": {**zero, "speeding_steps": 1},
     }
@@ -87,6 +93,15 @@ def test_violations_are_split_by_site() -> None:
     old = r.as_dict()
     del old["violations_by_site"]  # a file written before sites were recorded
     assert EpisodeResult.from_dict(old).violations_by_site == {}
+    # a file written before yield violations were counted: none, at every site
+    older = r.as_dict()
+    del older["yield_violations"]
+    for counts in older["violations_by_site"].values():
+        del counts["yield_violations"]
+    read = EpisodeResult.from_dict(older)
+    assert read.yield_violations == 0 and read.violations == 6
+    assert read.violations_by_site["yield_junction"] == {**zero, "collisions": 1}
+    assert list(read.violations_by_site["signal"]) == list(zero)  # the kinds' order
 
 
 def test_stop_latency_counts_steps_to_standstill():

@@ -13,7 +13,7 @@ from explaindrive.agent.config import preset
 from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.actions import action_index, limited_speed, next_speed
+from explaindrive.env.actions import action_index, limited_change, limited_speed, next_speed
 from explaindrive.env.safety import runtime_mask, safe_action_mask
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from tests.env.test_right_of_way import crossroads  # noqa: F401  (a fixture)
@@ -30,6 +30,16 @@ def test_a_rise_past_the_limit_lands_on_it() -> None:
     assert limited_speed(LIMIT, 1, LIMIT) == LIMIT  # holds 13.89
     assert limited_speed(12.5, -3, LIMIT) == 9.5  # braking: unchanged
     assert limited_speed(15.0, 2, LIMIT) == 15.0  # above the limit: it never brakes
+
+
+def test_the_change_applied_is_the_one_the_limiter_lets_through() -> None:
+    assert limited_change(12.0, 3, LIMIT) == pytest.approx(1.89)  # lands on 13.89
+    assert limited_change(LIMIT, 1, LIMIT) == 0.0  # holds the limit
+    assert limited_change(15.0, 2, LIMIT) == 0.0  # above it: keeps the speed
+    assert limited_change(12.5, 1, LIMIT) == 1  # within the limit: the action's
+    assert limited_change(12.5, -3, LIMIT) == -3  # braking: the action's
+    assert limited_change(12.0, 3, None) == 3  # no limiter
+    assert limited_change(1.0, -3, LIMIT) == -3  # the standstill clip is not the limiter's
 
 
 def _free_road(v: float) -> np.ndarray:
@@ -63,24 +73,29 @@ def test_only_the_passenger_preset_has_the_limiter() -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("limiter", "speeds"), [
-    (True, [3.0, 6.0, 9.0, 12.0, LIMIT, LIMIT]),  # passenger: fast holds 13.89
-    (False, [3.0, 6.0, 9.0, 12.0, 15.0, 18.0]),  # paper: speeding, judged on the true speed
+@pytest.mark.parametrize(("limiter", "speeds", "changes"), [
+    # passenger: fast holds 13.89; the step records the changes applied, 13.89 - 12 = 1.89
+    (True, [3.0, 6.0, 9.0, 12.0, LIMIT, LIMIT], [3.0, 3.0, 3.0, 3.0, 1.89, 0.0]),
+    # paper: speeding, judged on the true speed; every change is the action's
+    (False, [3.0, 6.0, 9.0, 12.0, 15.0, 18.0], [3.0] * 6),
 ])  # fmt: skip
 def test_the_env_holds_the_limit_with_the_limiter(
     make_env: Callable[..., UrbanDriveEnv],
     crossroads: tuple[Path, Path],  # noqa: F811
     limiter: bool,
     speeds: list[float],
+    changes: list[float],
 ) -> None:
     net, demand = crossroads
     env = make_env(net_file=net, route=("SJ", "JN"), demand_file=demand, warmup_s=0,
                    max_steps=10, speed_limiter=limiter)  # fmt: skip
     env.reset(seed=0)
-    seen, speeding = [], []
+    seen, speeding, applied = [], [], []
     for _ in speeds:
         _obs, _r, _term, _trunc, info = env.step(PLUS_3)
         seen.append(info["speed_mps"])
         speeding.append(info["speeding"])
+        applied.append(info["speed_change_mps"])
     assert seen == pytest.approx(speeds, abs=1e-6)
+    assert applied == pytest.approx(changes, abs=1e-6)
     assert speeding == [v > LIMIT for v in speeds]

@@ -147,20 +147,25 @@ def test_violations_by_site_are_summed_and_tabled() -> None:
     a["signal"]["red_light_runs"], a["free_road"]["speeding_steps"] = 2, 10
     b["signal"]["speeding_steps"], b["yield_junction"]["collisions"] = 3, 1
     b["crossing"]["ped_violations"] = 1
-    agg = aggregate([result(violations_by_site=a), result(violations_by_site=b)])
+    a["yield_junction"]["yield_violations"], b["yield_junction"]["yield_violations"] = 2, 1
+    agg = aggregate([result(violations_by_site=a, yield_violations=2),
+                     result(violations_by_site=b, yield_violations=1)])  # fmt: skip
+    assert agg.yield_violations == 3
     assert agg.violations_by_site == {
         "signal": {"collisions": 0, "red_light_runs": 2, "ped_violations": 0,
-                   "speeding_steps": 3},
+                   "yield_violations": 0, "speeding_steps": 3},
         "yield_junction": {"collisions": 1, "red_light_runs": 0, "ped_violations": 0,
-                           "speeding_steps": 0},
+                           "yield_violations": 3, "speeding_steps": 0},
         "crossing": {"collisions": 0, "red_light_runs": 0, "ped_violations": 1,
-                     "speeding_steps": 0},
+                     "yield_violations": 0, "speeding_steps": 0},
         "free_road": {"collisions": 0, "red_light_runs": 0, "ped_violations": 0,
-                      "speeding_steps": 10},
+                      "yield_violations": 0, "speeding_steps": 10},
     }  # fmt: skip
     # an episode from a file written before sites were recorded: no split for the group
     assert aggregate([result(violations_by_site=a), result()]).violations_by_site == {}
     row = site_table([RunSummary("fast", agg, {})]).splitlines()[2]
-    assert row == "| fast | 0 / 2 / 0 / 3 | 1 / 0 / 0 / 0 | 0 / 0 / 1 / 0 | 0 / 0 / 0 / 10 |"
+    assert row == (
+        "| fast | 0 / 2 / 0 / 0 / 3 | 1 / 0 / 0 / 3 / 0 | 0 / 0 / 1 / 0 / 0 | 0 / 0 / 0 / 0 / 10 |"
+    )
     none = site_table([RunSummary("old", aggregate([result()]), {})]).splitlines()[2]
     assert none == "| old | n/a | n/a | n/a | n/a |"

@@ -34,20 +34,23 @@ def test_the_table_counts_every_violation_kind_per_group() -> None:
     from explaindrive.evaluation.runner import EpisodeRecord
     from explaindrive.evaluation.spec import EpisodeSpec
 
-    def record(seed: int, speed: float, speeding: int, arrived: bool) -> EpisodeRecord:
+    def record(
+        seed: int, speed: float, speeding: int, arrived: bool, yields: int = 0
+    ) -> EpisodeRecord:
         result = EpisodeResult(
             steps=100, mean_speed_mps=speed, avg_headway_s=None, avg_ttc_s=None,
             avg_jerk_mps3=0.0, collisions=0, red_light_runs=0, ped_violations=0,
             speeding_steps=speeding, stop_latencies=(), unfinished_stops=0,
             stop_bound_misses=0, distance_m=800.0,
-            travel_time_s=100.0 if arrived else None, total_reward=0.0,
+            travel_time_s=100.0 if arrived else None, total_reward=0.0, yield_violations=yields,
         )  # fmt: skip
         spec = EpisodeSpec(parse_policy("krauss"), seed, 1.0, "fast", ())
         return EpisodeRecord(spec, result, (), (), ())
 
     table = gen.generalisation_section(
-        {("krauss", "held-out generated"): [record(0, 8.0, 3, True), record(1, 6.0, 2, False)]}
+        {("krauss", "held-out generated"): [record(0, 8.0, 3, True, 1), record(1, 6.0, 2, False)]}
     )
     row = next(line for line in table.splitlines() if line.startswith("| krauss"))
-    # mean speed weighted by steps: (8 + 6) / 2 = 7; speeding 3 + 2 = 5; one of two arrived
-    assert row == "| krauss | 7.000 | 0/2 | 0 | 0 | 5 | 1/2 |"
+    # mean speed weighted by steps: (8 + 6) / 2 = 7; one yield violation; speeding
+    # 3 + 2 = 5; one of two arrived
+    assert row == "| krauss | 7.000 | 0/2 | 0 | 0 | 1 | 5 | 1/2 |"

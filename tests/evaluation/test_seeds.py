@@ -20,9 +20,10 @@ def test_seed_table_lists_each_run_then_mean_and_spread() -> None:
     assert len(lines) == 2 + 2 + 2  # header, rule, two runs, mean, spread
     cells = [line.split(" | ") for line in lines[2:]]
     assert cells[0][2] == "0" and cells[1][2] == "2"  # collision episodes
-    assert cells[0][7] == "8.000" and cells[1][7] == "6.000"
-    assert cells[2][2] == "1.000" and cells[2][7] == "7.000"  # means
-    assert cells[3][2] == "1.000" and cells[3][7] == "1.000"  # population std
+    assert lines[0].split(" | ")[5] == "yield viol."
+    assert cells[0][8] == "8.000" and cells[1][8] == "6.000"  # mean speed
+    assert cells[2][2] == "1.000" and cells[2][8] == "7.000"  # means
+    assert cells[3][2] == "1.000" and cells[3][8] == "1.000"  # population std
     steps = runs[1].steps
     assert cells[1][-1].rstrip(" |") == f"{100 * 4 / steps:.3f}"
 

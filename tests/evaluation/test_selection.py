@@ -84,15 +84,15 @@ def test_fast_targets_against_krauss() -> None:
 
 def test_violations_are_summed_over_the_grids() -> None:
     a = figures(collision_episodes=1, red_light_runs=2, ped_violations=3, speeding_steps=4,
-                stop_bound_misses=5)  # fmt: skip
-    assert violations(a) == 15
+                stop_bound_misses=5, yield_violations=6)  # fmt: skip
+    assert violations(a) == 21  # 1 + 2 + 3 + 4 + 5 + 6
     c = cand(
         "c", "fast", GOOD_FAST, stops=figures(speeding_steps=3),
         noise=figures(collision_episodes=1),
         heavy_noise=figures(speeding_steps=20, red_light_runs=2),  # speeding not counted
     )  # fmt: skip
     assert judge(c, KRAUSS, IDM).violations == 6
-    assert violations(a, speeding=False) == 11
+    assert violations(a, speeding=False) == 17  # 21 - 4
 
 
 def test_rank_puts_violations_before_shortfall_before_objective() -> None:

@@ -20,9 +20,11 @@ yields one synthetic observation:
 - a row with nothing in range gets, in half the cases, a red light at such a distance, as
   its leader.
 
-The masks of these rows are computed by the same rule; the learner pushes their unsafe
-actions below their best safe one (:func:`~explaindrive.agent.targets.unsafe_action_loss`),
-weighted by ``boundary_weight``. Nothing else is learned from them: they have no reward.
+The masks of these rows are computed by the same rule (through the speed limiter when the
+config's ``speed_limiter`` is on, as the masks of the episodes' rows are); the learner
+pushes their unsafe actions below their best safe one
+(:func:`~explaindrive.agent.targets.unsafe_action_loss`), weighted by ``boundary_weight``.
+Nothing else is learned from them: they have no reward.
 
 With ``boundary_noise`` the network sees each synthetic row through observation noise
 (:func:`~explaindrive.env.noise.noisy_rows`) drawn as the episodes draw theirs: a share
@@ -87,12 +89,15 @@ def boundary_batch(
     dilemma_braking: bool,
     noise_max: tuple[float, float] = (0.0, 0.0),
     noisy_share: float = 0.0,
+    *,
+    speed_limiter: bool = False,
 ) -> tuple[NDArray[np.float32], NDArray[np.bool_]]:
     """Synthetic observations for a minibatch and their learning masks; with ``noise_max``
     and ``noisy_share`` set, the observations as seen through noise (the module docstring).
-    Without noise nothing more is drawn from ``rng``."""
+    Without noise nothing more is drawn from ``rng``. ``speed_limiter``: the masks judge
+    each action through the speed limiter."""
     synthetic = boundary_observations(obs, rng)
-    mask = training_mask(synthetic, dilemma_braking)
+    mask = training_mask(synthetic, dilemma_braking, speed_limiter)
     if noisy_share > 0.0 and noise_max != (0.0, 0.0):
         u = rng.uniform(size=(len(synthetic), 3))
         noisy = u[:, 2] < noisy_share

@@ -133,11 +133,12 @@ class D3QNLearner:
     def _margins(self, obs: np.ndarray) -> float | torch.Tensor | None:
         """The unsafe-action loss's margins for raw observations ``obs``: ``unsafe_margin``,
         or with ``limit_margin`` one per action, that one where the action exceeds the posted
-        limit at the speed the network sees."""
+        limit at the speed the network sees (through the speed limiter when
+        ``speed_limiter`` is on: a rise it lands on the limit does not exceed it)."""
         c = self.config
         if c.limit_margin is None or c.unsafe_margin is None:
             return c.unsafe_margin
-        over_limit = torch.from_numpy(~limit_mask(obs))
+        over_limit = torch.from_numpy(~limit_mask(obs, c.speed_limiter))
         return torch.where(over_limit, c.limit_margin, c.unsafe_margin)
 
     def update(

@@ -298,7 +298,12 @@ class Trainer:
             if c.safe_learning and c.boundary_weight > 0.0:
                 noise_max = c.obs_noise_max if c.boundary_noise else (0.0, 0.0)
                 boundary = boundary_batch(
-                    batch.obs, s.rng, c.dilemma_braking, noise_max, c.noisy_share
+                    batch.obs,
+                    s.rng,
+                    c.dilemma_braking,
+                    noise_max,
+                    c.noisy_share,
+                    speed_limiter=c.speed_limiter,
                 )
             stats = self.learner.update(batch, s.env_steps, boundary)
             if isinstance(buffer, PrioritizedReplayBuffer):

@@ -53,6 +53,7 @@ def demo(
         ("collisions", str(res.collisions)),
         ("red-light runs", str(res.red_light_runs)),
         ("pedestrian-yield violations", str(res.ped_violations)),
+        ("yield violations", str(res.yield_violations)),
         ("speeding steps", str(res.speeding_steps)),
         ("distance \\[m]", f"{res.distance_m:.1f}"),
         ("travel time \\[s]", _fmt(res.travel_time_s)),

@@ -383,7 +383,8 @@ def _print_summary(session: RideSession, outputs: RideOutputs) -> None:
     console.print(
         f"ride over after {len(session.records)} s: mean speed {m.mean_speed_mps:.2f} m/s, "
         f"collisions {m.collisions}, red-light runs {m.red_light_runs}, "
-        f"pedestrian-yield violations {m.ped_violations}, speeding steps {m.speeding_steps}"
+        f"pedestrian-yield violations {m.ped_violations}, yield violations "
+        f"{m.yield_violations}, speeding steps {m.speeding_steps}"
     )
     console.print(
         f"requests {c.requests}, questions {c.questions}, confirmed {c.confirmations}, "

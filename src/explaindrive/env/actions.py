@@ -59,6 +59,17 @@ def limited_speed(v_mps: float, change_mps: float, limit_mps: float | None) -> f
     return v_new
 
 
+def limited_change(v_mps: float, change_mps: int, limit_mps: float | None) -> float:
+    """[m/s] The speed change the speed limiter lets through of ``change_mps`` at ``v_mps``:
+    the change itself, except a rise that would pass ``limit_mps`` becomes ``limit - v``
+    (0 when ``v`` is already above it). ``None``: no limiter, the change itself. The clip at
+    standstill is not the limiter's and is not applied here (braking from 1 m/s by 3 m/s
+    stays -3)."""
+    if limit_mps is not None and change_mps > 0 and v_mps + change_mps > limit_mps:
+        return max(0.0, limit_mps - v_mps)
+    return change_mps
+
+
 def next_speed(v_mps: float, action: int, limit_mps: float | None = None) -> float:
     """Ego speed after applying ``action`` for one step, clipped at 0; with ``limit_mps``,
     through the speed limiter (:func:`limited_speed`)."""

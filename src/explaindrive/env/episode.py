@@ -84,7 +84,12 @@ class StepRecord:
 
     Attributes:
         command: the command the action was taken under.
-        change: the speed change applied [m/s] (SUMO's own for the baselines).
+        change: the speed change applied [m/s]: the action's, or with the speed limiter
+            on the one it let through (:func:`~explaindrive.env.actions.limited_change`:
+            +1 at 13 m/s under a 13.89 m/s limit applies +0.89); SUMO's own, rounded, for
+            the baselines. The reward reads it only under STOP, for its sign, which the
+            limiter never changes (a rise it cuts stays >= 0); the ride-quality figures and
+            the reward's braking terms read ``accel``, the change as driven.
         accel: the ego's acceleration over the step [m/s^2].
         jerk: its change from the previous step's [m/s^3].
         motion: what the simulation did with the ego.
@@ -97,7 +102,7 @@ class StepRecord:
     """
 
     command: Command
-    change: int
+    change: float
     accel: float
     jerk: float
     motion: Motion
@@ -120,7 +125,7 @@ class StepRecord:
             ttc_s=time_to_collision(leader.gap_m, v - leader.speed_mps) if leader else math.inf,
             headway_s=time_headway(leader.gap_m, leader.length_m, v) if leader else math.inf,
             jerk_mps3=self.jerk,
-            violation=self.violations.red_light_run or self.violations.ped_violation,
+            violation=self.violations.any,
             stop_reason=stop_reason,
             collided=self.motion.collided,
             real_headway_s=time_headway(real.gap_m, real.length_m, v) if real else math.inf,

@@ -2,8 +2,8 @@
 
 The paper reports, per episode: SUMO steps, mean speed, average time headway
 (TH), average time to collision (TTC), average jerk and AV collisions. We add
-red-light runs, pedestrian-yield violations, speed-limit violations, stop
-latency and travel time. Feed every ``info`` from ``env.step`` to
+red-light runs, pedestrian-yield violations, right-of-way (yield) violations,
+speed-limit violations, stop latency and travel time. Feed every ``info`` from ``env.step`` to
 :meth:`EpisodeMetrics.update`, then read :meth:`EpisodeMetrics.result`.
 
 Definitions:
@@ -21,10 +21,15 @@ Definitions:
     travel time  seconds until the ego left the route (None if it did not)
     ride         the ride-quality figures (free-road speed, hard brakes, reversals, jerk
                  percentiles, standstill gaps): :mod:`explaindrive.env.ride_quality`
-    by site      the collisions, red-light runs, pedestrian-yield violations and speeding
-                 steps again, split by where they happened: at a signal, a junction without
-                 one, a pedestrian crossing without one, or on the free road
-                 (:data:`SITES`, judged by :mod:`explaindrive.env.violations`)
+    yield viol.  yield lines crossed while a foe with priority was within the gap
+                 (:mod:`explaindrive.env.violations`)
+    violations   collisions + red-light runs + pedestrian-yield violations + yield
+                 violations + speeding steps (:attr:`EpisodeResult.violations`)
+    by site      the collisions, red-light runs, pedestrian-yield violations, yield
+                 violations and speeding steps again (:data:`VIOLATION_KINDS`), split by
+                 where they happened: at a signal, a junction without one, a pedestrian
+                 crossing without one, or on the free road (:data:`SITES`, judged by
+                 :mod:`explaindrive.env.violations`)
 """
 
 from __future__ import annotations
@@ -40,15 +45,36 @@ MOVING_SPEED_MPS = 1.0  # [m/s] headways are averaged over steps at or above thi
 SITES: tuple[str, ...] = ("signal", "yield_junction", "crossing", "free_road")
 """Where a step's violations happened (:mod:`explaindrive.env.violations` judges it)."""
 VIOLATION_KINDS: tuple[str, ...] = (
-    "collisions", "red_light_runs", "ped_violations", "speeding_steps",
+    "collisions", "red_light_runs", "ped_violations", "yield_violations", "speeding_steps",
 )  # fmt: skip
-"""The violation counts of :class:`EpisodeResult`, as split by site."""
-_INFO_FLAGS = ("collision", "red_light_run", "ped_violation", "speeding")  # in that order
+"""The violation counts of :class:`EpisodeResult`, as split by site (in this order)."""
+_INFO_FLAGS = (  # the step's ``info`` flag of each kind, in that order
+    "collision", "red_light_run", "ped_violation", "yield_violation", "speeding",
+)  # fmt: skip
 
 
 def no_violations_by_site() -> dict[str, dict[str, int]]:
     """Site -> violation kind -> 0, for every site and kind."""
     return {site: dict.fromkeys(VIOLATION_KINDS, 0) for site in SITES}
+
+
+def full_split(by_site: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
+    """A stored split by site with every kind of :data:`VIOLATION_KINDS`, in their order: a
+    kind it lacks (a file written before the kind was counted) is 0. An empty split (written
+    before sites were recorded) stays empty.
+
+    Raises:
+        KeyError: for a site not in :data:`SITES` or a kind not in :data:`VIOLATION_KINDS`.
+    """
+    if not by_site:
+        return {}
+    split = no_violations_by_site()
+    for site, counts in by_site.items():
+        for kind, n in counts.items():
+            if kind not in split[site]:
+                raise KeyError(f"unknown violation kind {kind!r}")
+            split[site][kind] = int(n)
+    return split
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,13 +102,16 @@ class EpisodeResult:
     were recorded."""
     yield_violations: int = 0
     """Yield lines crossed while a foe with priority was within the gap
-    (:mod:`explaindrive.env.violations`); not yet in :attr:`violations` nor split by site
-    (0 for an episode stored before it was counted)."""
+    (:mod:`explaindrive.env.violations`); in :attr:`violations` and split by site like the
+    other kinds (0 for an episode stored before it was counted)."""
 
     @property
     def violations(self) -> int:
-        """Collisions plus every rule violation."""
-        return self.collisions + self.red_light_runs + self.ped_violations + self.speeding_steps
+        """Collisions plus every rule violation (:data:`VIOLATION_KINDS`)."""
+        return (
+            self.collisions + self.red_light_runs + self.ped_violations + self.yield_violations
+            + self.speeding_steps
+        )  # fmt: skip
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict."""
@@ -94,13 +123,20 @@ class EpisodeResult:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> EpisodeResult:
-        """The inverse of :meth:`as_dict` (an evaluation file's episode ``metrics``).
+        """The inverse of :meth:`as_dict` (an evaluation file's episode ``metrics``); a file
+        written before yield violations were counted reads as none (:func:`full_split`).
 
         Raises:
             KeyError, TypeError: for a dict that lacks a field or holds another.
         """
-        return cls(**{**d, "stop_latencies": tuple(d["stop_latencies"]),
-                      "ride": RideQualityResult.from_dict(d["ride"])})  # fmt: skip
+        return cls(
+            **{
+                **d,
+                "stop_latencies": tuple(d["stop_latencies"]),
+                "ride": RideQualityResult.from_dict(d["ride"]),
+                "violations_by_site": full_split(d.get("violations_by_site", {})),
+            }
+        )
 
 
 def _mean(values: list[float]) -> float | None:
@@ -151,7 +187,7 @@ class EpisodeMetrics:
         self.yield_violations += int(bool(info.get("yield_violation", False)))
         at_site = self.by_site[info["site"]]
         for kind, flag in zip(VIOLATION_KINDS, _INFO_FLAGS, strict=True):
-            at_site[kind] += int(bool(info[flag]))
+            at_site[kind] += int(bool(info.get(flag, False)))
         self.distance_m = float(info["distance_m"])
         self.time_s = float(info["time_s"])
         self.arrived = self.arrived or bool(info.get("arrived", False))

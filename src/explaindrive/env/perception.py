@@ -109,6 +109,10 @@ class Percept:
 class LeaderSensor:
     """The vehicle ahead in the ego's lane within sensor range (bumper-to-bumper gap).
 
+    SUMO's leader of the ego (``VAR_LEADER``, read after each step), so a vehicle that
+    changes into the ego's lane ahead is the leader from the step it is in the lane, and
+    one beside the ego is none (tests/env/test_cut_in.py).
+
     Args:
         ego_min_gap_m: the ego's minGap, which SUMO subtracts from leader gaps [m].
         lengths: a cache of vehicle lengths by id, shared across episodes.

@@ -241,7 +241,8 @@ def traffic_rules_reward(
     (the paper: +r_respect) for a stop at a red light or for a pedestrian.
 
     Args:
-        violation: a red light was run or a pedestrian crossing was violated in this step.
+        violation: a red light was run, a pedestrian crossing was violated or a yield line
+            was crossed before a foe with priority (a yield violation) in this step.
         stopped: the ego stands still after the step.
         stop_reason: why standing still is justified: ``"signal"`` (red/yellow light or
             pedestrian, i.e. the virtual leader), ``"queue"`` (a real vehicle close
@@ -300,7 +301,7 @@ def collision_reward(collided: bool) -> float:
     return -R_CRITICAL if collided else 0.0
 
 
-def stop_reward(speed_mps: float, speed_change_mps: int) -> float:
+def stop_reward(speed_mps: float, speed_change_mps: float) -> float:
     """R2: r_respect at standstill, -r_critical when keeping or raising speed, else 0."""
     if speed_mps <= 0.0:
         return R_RESPECT
@@ -314,12 +315,12 @@ class StepFeatures:
     """Everything a reward needs about one step."""
 
     speed_mps: float  # ego speed after the step
-    speed_change_mps: int  # the action's speed change
+    speed_change_mps: float  # the speed change applied (through the speed limiter, if on)
     limit_mps: float  # posted limit the agent observed
     ttc_s: float  # w.r.t. the effective (real or virtual) leader
     headway_s: float  # w.r.t. the effective leader
     jerk_mps3: float
-    violation: bool
+    violation: bool  # a red-light run, pedestrian-yield or yield violation in the step
     stop_reason: str | None
     collided: bool
     real_headway_s: float = math.inf  # w.r.t. the real leader (inf without one)

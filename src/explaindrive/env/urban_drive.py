@@ -32,6 +32,7 @@ from explaindrive.env.actions import (
     N_ACTIONS,
     STEP_LENGTH_S,
     least_stopping_need,
+    limited_change,
     limited_speed,
     speed_change,
     stopping_need,
@@ -231,9 +232,12 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         ep = self._episode()
         if ep.done:
             raise RuntimeError("the episode is over; call reset() before step()")
-        change = speed_change(action)
+        action_change = speed_change(action)
         cmd, prev_obs, prev_pos, seen = ep.command, self._last_obs, ep.pos_m, ep.seen
-        motion = self._advance(ep, change, float(prev_obs[S.V_LIM]))
+        posted_limit_mps = float(prev_obs[S.V_LIM])
+        limit = posted_limit_mps if self.config.speed_limiter else None
+        change: float = limited_change(ep.speed_mps, action_change, limit)
+        motion = self._advance(ep, action_change, posted_limit_mps)
         if self.config.ego_model != "agent":
             change = round(motion.speed_mps - ep.speed_mps)
         accel = motion.speed_mps - ep.speed_mps

@@ -52,6 +52,12 @@ class Violations:
     site: str = "free_road"
     yield_violation: bool = False
 
+    @property
+    def any(self) -> bool:
+        """A stop line was violated: a red-light run, a pedestrian-yield or a yield violation
+        (what the reward's traffic term charges)."""
+        return self.red_light_run or self.ped_violation or self.yield_violation
+
 
 class ViolationJudge:
     """Judges the ego's passage over the stop lines of its route.

@@ -5,7 +5,8 @@ Conventions (as in the paper's table, which averages over its 25 episodes):
     avg TH, avg TTC               mean of the per-episode averages, over the episodes that
                                   have one (an episode without a leader has no TH)
     collisions                    episodes with an AV collision ("0/25")
-    red-light / ped / speeding    totals over the episodes
+    red-light / ped / yield /     totals over the episodes (yield: right-of-way violations;
+    speeding                      0 for an episode stored before they were counted)
     violations by site            totals over the episodes, per site and kind (empty when
                                   an episode of the group has no split, e.g. one read from
                                   a file written before sites were recorded)
@@ -72,6 +73,8 @@ class Aggregate:
     crossing_stops: int = 0
     crossing_stop_gap_mean_m: float | None = None
     stop_gap_in_window_share: float | None = None
+    yield_violations: int = 0
+    """Yield lines crossed while a foe with priority was within the gap, in total."""
     violations_by_site: dict[str, dict[str, int]] = field(default_factory=dict)
     """Site -> kind -> total (:data:`~explaindrive.env.metrics.VIOLATION_KINDS`)."""
 
@@ -135,6 +138,7 @@ def aggregate(results: Sequence[EpisodeResult]) -> Aggregate:
         arrived=len(travel),
         travel_time_mean_s=mean(travel),
         **ride_quality([r.ride for r in results], math.fsum(r.distance_m for r in results)),
+        yield_violations=sum(r.yield_violations for r in results),
         violations_by_site=violations_by_site(results),
     )
 

@@ -121,13 +121,14 @@ def run_generalisation(
 
 def generalisation_section(by_run: Mapping[tuple[str, str], Sequence[EpisodeRecord]]) -> str:
     """The table: a row per policy; per scenario group mean speed, collisions, red-light
-    runs, pedestrian-yield violations, speeding steps and arrivals over its episodes."""
+    runs, pedestrian-yield violations, yield violations, speeding steps and arrivals over its
+    episodes."""
     policies = list(dict.fromkeys(name for name, _ in by_run))
     groups = list(dict.fromkeys(group for _, group in by_run))
     header = ["policy"]
     for group in groups:
-        header += [f"{group}: speed m/s", "collisions", "red runs", "ped viol.", "speeding",
-                   "arrived"]  # fmt: skip
+        header += [f"{group}: speed m/s", "collisions", "red runs", "ped viol.", "yield viol.",
+                   "speeding", "arrived"]  # fmt: skip
     lines = ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
     for name in policies:
         row = [name]
@@ -135,7 +136,8 @@ def generalisation_section(by_run: Mapping[tuple[str, str], Sequence[EpisodeReco
             recs = by_run.get((name, group), [])
             o = summarize(name, [(r.spec.traffic_level, r.result) for r in recs]).overall
             row += [fmt(o.mean_speed_mps), f"{o.collision_episodes}/{o.episodes}",
-                    str(o.red_light_runs), str(o.ped_violations), str(o.speeding_steps),
+                    str(o.red_light_runs), str(o.ped_violations), str(o.yield_violations),
+                    str(o.speeding_steps),
                     f"{o.arrived}/{o.episodes}"]  # fmt: skip
         lines.append("| " + " | ".join(row) + " |")
     first = next(iter(by_run.values()), [])

@@ -110,5 +110,6 @@ def _baseline_line(name: str, s: RunSummary) -> str:
     return (
         f"- **{name}** (SUMO, not in the paper): mean speed {o.mean_speed_mps:.3f} m/s, "
         f"{o.collision_episodes}/{o.episodes} collision episodes, {o.red_light_runs} "
-        f"red-light runs, {o.ped_violations} pedestrian-yield violations."
+        f"red-light runs, {o.ped_violations} pedestrian-yield violations, "
+        f"{o.yield_violations} yield violations."
     )

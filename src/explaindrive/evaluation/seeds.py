@@ -67,6 +67,7 @@ _COLUMNS: tuple[tuple[str, str], ...] = (
     ("collisions", "collision_episodes"),
     ("red-light runs", "red_light_runs"),
     ("ped-yield viol.", "ped_violations"),
+    ("yield viol.", "yield_violations"),
     ("speeding steps", "speeding_steps"),
     ("stops over bound", "stop_bound_misses"),
     ("mean speed m/s", "mean_speed_mps"),

@@ -84,10 +84,11 @@ def within(name: str, value: float | None, lo: float, hi: float) -> Target:
 
 
 def violations(a: Aggregate, speeding: bool = True) -> int:
-    """Collisions (episodes), red-light runs, pedestrian-yield violations, stops over their
-    bound and, unless ``speeding`` is false, speeding steps."""
+    """Collisions (episodes), red-light runs, pedestrian-yield violations, yield violations,
+    stops over their bound and, unless ``speeding`` is false, speeding steps."""
     return (
-        a.collision_episodes + a.red_light_runs + a.ped_violations + a.stop_bound_misses
+        a.collision_episodes + a.red_light_runs + a.ped_violations + a.yield_violations
+        + a.stop_bound_misses
         + (a.speeding_steps if speeding else 0)
     )  # fmt: skip
 

@@ -93,7 +93,8 @@ def level_table(summaries: Sequence[RunSummary]) -> str:
 def safety_table(summaries: Sequence[RunSummary]) -> str:
     """The measures the paper does not report: rule violations, stops and travel time."""
     header = [
-        "policy", "episodes", "red-light runs", "ped-yield violations", "speeding steps (share)",
+        "policy", "episodes", "red-light runs", "ped-yield violations", "yield violations",
+        "speeding steps (share)",
         "stops done", "stop latency mean/max steps", "over ceil(v/3)+2", "unfinished stops",
         "arrived",
         "travel time s",
@@ -103,7 +104,8 @@ def safety_table(summaries: Sequence[RunSummary]) -> str:
         o = s.overall
         rows.append([
             s.name, str(o.episodes), str(o.red_light_runs), str(o.ped_violations),
-            f"{o.speeding_steps} ({100 * o.speeding_share:.1f}%)", str(o.stops),
+            str(o.yield_violations), f"{o.speeding_steps} ({100 * o.speeding_share:.1f}%)",
+            str(o.stops),
             f"{fmt(o.stop_latency_mean_steps, 2)}/{fmt(o.stop_latency_max_steps)}",
             str(o.stop_bound_misses), str(o.unfinished_stops), f"{o.arrived}/{o.episodes}",
             fmt(o.travel_time_mean_s, 1),
@@ -120,8 +122,13 @@ SITE_HEADERS: dict[str, str] = {
 
 def site_table(summaries: Sequence[RunSummary]) -> str:
     """Where the violations happened: per site, collisions / red-light runs / pedestrian-yield
-    violations / speeding steps (``n/a`` for a run with no split by site)."""
-    header = ["policy (collisions / red-light / ped-yield / speeding)", *SITE_HEADERS.values()]
+    violations / yield violations / speeding steps (the order of
+    :data:`~explaindrive.env.metrics.VIOLATION_KINDS`; ``n/a`` for a run with no split by
+    site)."""
+    header = [
+        "policy (collisions / red-light / ped-yield / yield / speeding)",
+        *SITE_HEADERS.values(),
+    ]
     rows = []
     for s in summaries:
         by_site = s.overall.violations_by_site
@@ -164,13 +171,13 @@ def episode_table(rows: Sequence[tuple[int, float, EpisodeResult]]) -> str:
     header = [
         "seed", "traffic level", "steps", "mean speed m/s", "avg TH s", "avg TTC s",
         "avg jerk m/s^3", "collision", "red-light runs", "ped-yield violations",
-        "speeding steps", "stop latencies", "travel time s",
+        "yield violations", "speeding steps", "stop latencies", "travel time s",
     ]  # fmt: skip
     body = [
         [
             str(seed), str(float(level)), str(r.steps), fmt(r.mean_speed_mps), fmt(r.avg_headway_s),
             fmt(r.avg_ttc_s), fmt(r.avg_jerk_mps3), str(r.collisions), str(r.red_light_runs),
-            str(r.ped_violations), str(r.speeding_steps),
+            str(r.ped_violations), str(r.yield_violations), str(r.speeding_steps),
             ",".join(map(str, r.stop_latencies)) or DASH, fmt(r.travel_time_s, 1),
         ]
         for seed, level, r in rows

@@ -44,6 +44,10 @@ log = logging.getLogger(__name__)
 
 __all__ = ["FALLBACK_MARGIN_S", "RideCounts", "RideSession", "StepRecord", "check_deadlines"]
 
+STEP_FLAGS: tuple[str, ...] = (
+    "collision", "red_light_run", "ped_violation", "yield_violation", "speeding", "arrived",
+)  # fmt: skip
+"""The step ``info`` flags a ride's step record keeps."""
 FALLBACK_MARGIN_S = 0.2
 """[s] time a language task keeps, after a remote model's deadline, for the embedded
 module to answer instead."""
@@ -211,10 +215,7 @@ class RideSession:
             speed_mps=float(info["speed_mps"]),
             limit_mps=float(info["limit_mps"]),
             reward=float(reward),
-            flags={
-                k: bool(info[k])
-                for k in ("collision", "red_light_run", "ped_violation", "speeding", "arrived")
-            },
+            flags={k: bool(info[k]) for k in STEP_FLAGS},
             passenger=self._inbox,
             latency_s={"policy": policy_s},
             shield=self._shield_event(),

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from itertools import pairwise
 from pathlib import Path
 
 import pytest
 
+from explaindrive.env.right_of_way import junction_of, link_yields
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.sim.route import load_route_geometry
 from explaindrive.sim.scenario.directory import (
@@ -89,3 +91,45 @@ def test_a_quarter_of_the_episode_seeds_draw_the_papers_road() -> None:
     assert sum(draws_paper_road(seed, 0.25) for seed in range(1000)) == 250
     assert not any(draws_paper_road(seed, 0.0) for seed in range(1000))
     assert all(draws_paper_road(seed, 1.0) for seed in range(1000))
+
+
+def _route_links(net_file: Path, route_edges: tuple[str, ...]) -> list[tuple[str, str]]:
+    """(junction, link state) of each connection between consecutive edges of the route."""
+    import sumolib
+
+    net = sumolib.net.readNet(str(net_file), withInternal=True)
+    links = []
+    for a, b in pairwise(route_edges):
+        for conn in net.getEdge(a).getOutgoing().get(net.getEdge(b), []):
+            links.append((junction_of(conn.getViaLaneID()), conn.getState()))
+    return links
+
+
+@pytest.mark.parametrize("end", ["high", "low"])
+def test_the_family_draws_priority_junctions_the_ego_yields_at(end: str, tmp_path: Path) -> None:
+    params = extreme_params(end)  # type: ignore[arg-type]
+    drawn = params.priority_junction
+    assert drawn is (end == "high")
+    files = load_scenario_dir(cached_scenario_dir(params, end, tmp_path), tmp_path)
+    # the route's links, as netconvert built them: J1 and J2 signalised ("O" and "o", the
+    # lights' own states before the programme), the zebra PX a minor link (its pedestrians
+    # have priority; the crossing sensor handles it), Z2 major; Z1 minor where the side road
+    # has right of way, major on a road without it
+    links = _route_links(files.net_file, files.route_edges)
+    z1 = "m" if drawn else "M"
+    assert links == [("J1", "O"), ("Z1", z1), ("PX", "m"), ("Z2", "M"), ("J2", "o")]
+    # where the ego must yield to vehicles: at Z1, a junction without a light or crossing
+    geometry = load_route_geometry(files.net_file, files.route_edges)
+    plain = {j.node_id for j in geometry.junctions if not (j.signalized or j.crossing)}
+    yields = [j for j, state in links if link_yields(state) and j in plain]
+    assert yields == (["Z1"] if drawn else [])
+    # its side road carries a flow each way at the drawn rate (120 veh/h at the high end)
+    assert files.plan is not None
+    flows = [(f.nodes, f.veh_per_hour) for f in files.plan.flows if f.id.startswith("z1_")]
+    assert flows == ([(("Z1N", "Z1", "Z1S"), 120.0), (("Z1S", "Z1", "Z1N"), 120.0)] if drawn
+                     else [])  # fmt: skip
+
+
+def test_about_half_the_scenarios_have_a_priority_junction() -> None:
+    # drawn last (after the demand), so the values drawn before are those of earlier versions
+    assert sum(random_params(seed).priority_junction for seed in range(50)) == 21

@@ -59,12 +59,22 @@ def edges_xml(plan: layout.Layout = layout.PAPER_LAYOUT) -> str:
                     to=b,
                     numLanes=1,
                     speed=f"{road.speed_mps:.4f}",
-                    priority=2 if road.a in layout.EGO_ROUTE_NODES else 1,
+                    priority=_priority(road),
                     sidewalkWidth=layout.SIDEWALK_WIDTH_M,
                 )
             lines.append(f"    <edge {attrs}/>")
     lines.append("</edges>")
     return "\n".join(lines) + "\n"
+
+
+def _priority(road: layout.Road) -> int:
+    """netconvert's edge priority of ``road``: its own, else the main road's for a road
+    starting on the ego's route and the side roads' for the others."""
+    if road.priority is not None:
+        return road.priority
+    if road.a in layout.EGO_ROUTE_NODES:
+        return layout.MAIN_ROAD_PRIORITY
+    return layout.SIDE_ROAD_PRIORITY
 
 
 def connections_xml(plan: layout.Layout = layout.PAPER_LAYOUT) -> str:

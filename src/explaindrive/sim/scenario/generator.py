@@ -45,6 +45,8 @@ RANGES: dict[str, tuple[float, float, float]] = {
     "j2_turn_south": (50, 250, 25),
     "j2_turn_north": (50, 250, 25),
     "j2_cross": (20, 120, 10),
+    "priority_junction": (0, 1, 1),  # 0: no, 1: Z1 is a priority junction the ego yields at
+    "z1_cross": (20, 120, 10),  # the main road yields to it: more jams it at high levels
 }
 _SIGNAL_KEYS = ("cycle_s", "main_share", "yellow_s", "all_red_s")
 _DEMAND_KEYS = ("main_east", "main_west", "j1_cross", "j2_turn_south", "j2_turn_north",
@@ -70,6 +72,9 @@ def _params(pick: Any) -> ScenarioParams:
         data[light] = {"cycle_s": cycle, "main_green_s": round(share * green),
                        "yellow_s": yellow, "all_red_s": all_red, "offset_s": offset}  # fmt: skip
     data["demand"] = {key: float(pick(key)) for key in _DEMAND_KEYS}
+    # drawn last, so that every value drawn before keeps its draw of earlier versions
+    data["priority_junction"] = bool(pick("priority_junction"))
+    data["demand"]["z1_cross"] = float(pick("z1_cross"))
     return ScenarioParams.from_dict(data)
 
 

@@ -15,6 +15,9 @@ direction plus sidewalks) from ``W0`` to ``E0``::
 * ``J2``: second signalized intersection; side-road traffic turns onto the
   main road ahead of the ego (leading vehicles); a pedestrian crossing on its
   west arm is signalized together with the lights.
+* ``Z1`` (with ``priority_junction``): an unsignalised priority junction; a side road
+  ``Z1N``-``Z1S`` with right of way (edge priority :data:`PRIORITY_ROAD`, above the main
+  road's) crosses the main road, and the ego must yield to its traffic.
 """
 
 from __future__ import annotations
@@ -53,6 +56,8 @@ class Road:
     b: str
     speed_mps: float  # [m/s] speed limit
     kind: str = "street"  # "street" (vehicles + sidewalk) or "footpath" (pedestrians only)
+    priority: int | None = None
+    """netconvert's edge priority of both edges; ``None``: 2 on the main road, 1 elsewhere."""
 
     @property
     def forward(self) -> str:
@@ -111,6 +116,9 @@ CROSSINGS: tuple[tuple[str, tuple[str, ...]], ...] = (
 TLS_CYCLE_S = 60
 TLS_YELLOW_S = 3
 TLS_ALL_RED_S = 2  # [s] clearance between conflicting streams
+MAIN_ROAD_PRIORITY = 2  # netconvert's edge priority of the main road
+SIDE_ROAD_PRIORITY = 1  # of the side roads at the lights
+PRIORITY_ROAD = 3  # of the side road at a priority junction: above the main road's
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,13 +146,25 @@ def make_layout(params: ScenarioParams) -> Layout:
         nodes.append(Node(f"J1{n}", x["J1"], y, "dead_end"))
         nodes.append(Node(f"PX{n}", x["PX"], FOOTPATH_M if y > 0 else -FOOTPATH_M, "dead_end"))
         nodes.append(Node(f"J2{n}", x["J2"], y, "dead_end"))
-    order = ("W0", "J1", "J1N", "J1S", "Z1", "PX", "PXN", "PXS", "Z2", "J2", "J2N", "J2S", "E0")
+    z1_side = ("Z1N", "Z1S") if params.priority_junction else ()
+    if params.priority_junction:
+        nodes += [Node(n, x["Z1"], y, "dead_end") for n, y in zip(z1_side, (SIDE_ROAD_M,
+                  -SIDE_ROAD_M), strict=True)]  # fmt: skip
+    order = ("W0", "J1", "J1N", "J1S", "Z1", *z1_side, "PX", "PXN", "PXS", "Z2", "J2", "J2N",
+             "J2S", "E0")  # fmt: skip
     by_id = {n.id: n for n in nodes}
     limits = (main, main, zone, zone, main, main)
     roads = [Road(a, b, v) for (a, b), v in zip(pairwise(EGO_ROUTE_NODES), limits, strict=True)]
     roads += [Road(f"{j}{n}", j, side) for j in ("J1", "J2") for n in ("N", "S")]
     roads += [Road(f"PX{n}", "PX", FOOTPATH_SPEED_MPS, kind="footpath") for n in ("S", "N")]
+    roads += [Road(n, "Z1", side, priority=PRIORITY_ROAD) for n in z1_side]
     d = params.demand
+    z1_flows = (
+        (Flow("z1_north_south", ("Z1N", "Z1", "Z1S"), d.z1_cross),
+         Flow("z1_south_north", ("Z1S", "Z1", "Z1N"), d.z1_cross))
+        if params.priority_junction
+        else ()
+    )  # fmt: skip
     flows = (
         Flow("main_east", EGO_ROUTE_NODES, d.main_east),
         Flow("main_west", tuple(reversed(EGO_ROUTE_NODES)), d.main_west),
@@ -154,6 +174,7 @@ def make_layout(params: ScenarioParams) -> Layout:
         Flow("j2_north_east", ("J2N", "J2", "E0"), d.j2_turn_north),
         Flow("j2_south_north", ("J2S", "J2", "J2N"), d.j2_cross),
         Flow("j2_north_south", ("J2N", "J2", "J2S"), d.j2_cross),
+        *z1_flows,
     )
     zebra, j2 = params.zebra_peds_per_hour, params.j2_peds_per_hour
     # pedestrians at J2 walk along the block Z2-J2 from 150 m (at most 3/4 of it) to 50 m

@@ -10,7 +10,9 @@ The road, west to east (block lengths in metres)::
     W0 --approach_m-- J1 --j1_to_zone_m-- Z1 --zone_to_crossing_m-- PX
        --crossing_to_zone_end_m-- Z2 --zone_end_to_j2_m-- J2 --exit_m-- E0
 
-``Z1``..``Z2`` is the low-limit zone around the zebra ``PX``.
+``Z1``..``Z2`` is the low-limit zone around the zebra ``PX``. With ``priority_junction``,
+``Z1`` is also an unsignalised priority junction where a side road with right of way
+crosses the main road: the ego must yield there.
 """
 
 from __future__ import annotations
@@ -107,6 +109,9 @@ class DemandParams(StrictModel):
     """From J2's north arm turning east ahead of the ego."""
     j2_cross: float = Field(default=60.0, ge=0.0, le=200.0)
     """Across the main road at J2, each direction."""
+    z1_cross: float = Field(default=120.0, ge=0.0, le=300.0)
+    """Across the main road at Z1, each direction, when Z1 is a priority junction
+    (``ScenarioParams.priority_junction``; no flow without it)."""
 
 
 class ScenarioParams(ConfigModel):
@@ -142,6 +147,10 @@ class ScenarioParams(ConfigModel):
     """Pedestrians crossing J2's west arm per hour, each direction."""
     demand: DemandParams = DemandParams()
     """Vehicle flows at traffic level 1.0."""
+    priority_junction: bool = False
+    """Z1 is an unsignalised priority junction: a side road crosses the main road there
+    with right of way over it, so the ego's link is a minor one (SUMO's state ``m``) and
+    it must yield to the side road's traffic. The paper's road has none."""
 
     @model_validator(mode="after")
     def _check_signals(self) -> Self:
