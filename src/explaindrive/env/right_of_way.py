@@ -53,6 +53,10 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import SPEED_CHANGES_MPS, STEP_LENGTH_S, can_stop_before
 from explaindrive.sim.scenario.files import EGO_ID
 
+YIELD_JUDGE_GAP_S = 1.0
+"""[s] The gap a yield violation breaks: SUMO's default ``jmTimegapMinor``, the time its own
+drivers keep ahead of a prioritised vehicle. The judge is SUMO's rule, so SUMO's drivers are
+not flagged for what they are built to do; the ego perceives with :data:`YIELD_MARGIN_S`."""
 YIELD_MARGIN_S = 2.0
 """[s] A foe with priority must reach the conflict at least this long after the ego has left
 it: SUMO's default ``jmTimegapMinor`` (1 s), the gap its Krauss drivers keep ahead of a
@@ -149,6 +153,7 @@ def must_yield(
     ego_speed_mps: float,
     ego_limit_mps: float,
     ego_length_m: float,
+    margin_s: float = YIELD_MARGIN_S,
 ) -> bool:
     """The rule (module docstring): whether the ego must let ``foe`` pass before it enters.
 
@@ -159,6 +164,8 @@ def must_yield(
         ego_speed_mps: the ego's speed.
         ego_limit_mps: the ego's posted limit (its top speed through the junction).
         ego_length_m: the ego's length.
+        margin_s: the gap the foe must arrive after the ego has cleared the conflict:
+            :data:`YIELD_MARGIN_S` to perceive, :data:`YIELD_JUDGE_GAP_S` to judge.
     """
     if not link_yields(ego_link_state) or not foe.ego_responds:
         return False
@@ -170,7 +177,7 @@ def must_yield(
     foe_arrives = arrival_time_s(
         foe.foe_dist_m, motion.speed_mps, motion.accel_mps2, motion.max_speed_mps
     )
-    return foe_arrives < ego_clear + YIELD_MARGIN_S
+    return foe_arrives < ego_clear + margin_s
 
 
 class YieldReading(NamedTuple):
@@ -179,8 +186,9 @@ class YieldReading(NamedTuple):
     Attributes:
         leader_gap_m: to the nearest where the ego must yield and can still stop: a
             virtual leader.
-        due_gap_m: to the nearest where the ego must yield, whether or not it can still
-            stop (what the yield-violation judge reads).
+        due_gap_m: to the nearest where a foe with priority is within SUMO's own gap
+            (:data:`YIELD_JUDGE_GAP_S`), whether or not the ego can still stop (what the
+            yield-violation judge reads).
     """
 
     leader_gap_m: float = S.SENSOR_RANGE_M
@@ -275,8 +283,10 @@ class YieldSensor:
             if gap is None or gap >= leader:
                 continue
             motion = self.foe_motion(api, foe)
-            if must_yield(state, foe, motion, speed_mps, limit_mps, self.ego_length_m):
-                due = min(due, gap)
+            args = (state, foe, motion, speed_mps, limit_mps, self.ego_length_m)
+            if must_yield(*args):
                 if can_stop_before(speed_mps, gap):
                     leader = gap
+                if must_yield(*args, margin_s=YIELD_JUDGE_GAP_S):
+                    due = min(due, gap)
         return YieldReading(leader, due)
