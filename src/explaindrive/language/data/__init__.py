@@ -26,6 +26,10 @@ EVERYDAY_CHECK = "everyday_check.csv.gz"
 selected on."""
 HELDOUT_CSV = "commands_heldout2.csv"
 """The test split: written and committed before any model was run on it, scored once."""
+NEXT_HELDOUT_CSV = "commands_heldout3.csv"
+"""The next test split: written by an author who saw neither the data nor the models and
+committed before any model was run on it; no model has been scored on it yet. The next
+model's training drops the lines near it, and it is scored once, when that model ships."""
 FIRST_HELDOUT_CSV = "commands_heldout.csv"
 """A development split: the previous test split (scored once, its errors read since),
 trained on."""
