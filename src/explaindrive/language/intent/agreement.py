@@ -72,12 +72,13 @@ def reconcile(
 ) -> Verdict:
     """Decide between the embedded reading ``local`` (with its probability ``local_p``)
     and the remote reading ``remote`` (``None``: "not a driving request"); the embedded
-    reading is sure from probability ``sure_p``."""
+    reading is sure from probability ``sure_p`` (``sure_p = 1``: never, even at a
+    probability that rounds to 1)."""
     if local is Command.STOP:
         return Verdict(Command.STOP, "embedded", "stop-local")
     if local == remote:
         return Verdict(local, "both", "agree")
-    sure = local_p >= sure_p
+    sure = local_p >= sure_p and sure_p < 1.0
     if local is None and sure:
         return Verdict(None, "embedded", "local-sure-none")
     if local is not None and sure:
