@@ -174,7 +174,7 @@ def ride(
     _drive_and_report(session, lines, staging, out, typed, live)
 
 
-def module_deadlines(text: str | None) -> dict[str, float]:
+def module_deadlines(text: str | None) -> dict[str, Any]:
     """``--deadlines INTERPRET,DECIDE,EXPLAIN`` as ``RideConfig`` fields ({} when not given).
 
     Raises:

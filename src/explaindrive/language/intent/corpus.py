@@ -136,7 +136,7 @@ def near_copies(tests: Iterable[str], seen: Iterable[str]) -> set[str]:
     round). One matcher per second sequence, whose tables difflib caches, keeps this fast.
     """
     tests_l = sorted({t.lower() for t in tests})
-    seen_by = {}
+    seen_by: dict[str, str] = {}
     for s in seen:
         seen_by.setdefault(s.lower(), s)
     near: set[str] = set()
