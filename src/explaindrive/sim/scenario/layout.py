@@ -133,6 +133,29 @@ class Layout:
     tls_offsets_s: dict[str, int]
 
 
+def _vehicle_flows(params: ScenarioParams) -> tuple[Flow, ...]:
+    """The background traffic's flows: the main road both ways, the crossing and turning
+    traffic at J1 and J2, and at Z1 with a priority junction."""
+    d = params.demand
+    z1_flows = (
+        (Flow("z1_north_south", ("Z1N", "Z1", "Z1S"), d.z1_cross),
+         Flow("z1_south_north", ("Z1S", "Z1", "Z1N"), d.z1_cross))
+        if params.priority_junction
+        else ()
+    )  # fmt: skip
+    return (
+        Flow("main_east", EGO_ROUTE_NODES, d.main_east),
+        Flow("main_west", tuple(reversed(EGO_ROUTE_NODES)), d.main_west),
+        Flow("j1_north_south", ("J1N", "J1", "J1S"), d.j1_cross),
+        Flow("j1_south_north", ("J1S", "J1", "J1N"), d.j1_cross),
+        Flow("j2_south_east", ("J2S", "J2", "E0"), d.j2_turn_south),
+        Flow("j2_north_east", ("J2N", "J2", "E0"), d.j2_turn_north),
+        Flow("j2_south_north", ("J2S", "J2", "J2N"), d.j2_cross),
+        Flow("j2_north_south", ("J2N", "J2", "J2S"), d.j2_cross),
+        *z1_flows,
+    )
+
+
 def make_layout(params: ScenarioParams) -> Layout:
     """The nodes, roads, flows and signal timings of a scenario of the family."""
     blocks = (params.approach_m, params.j1_to_zone_m, params.zone_to_crossing_m,
@@ -158,24 +181,7 @@ def make_layout(params: ScenarioParams) -> Layout:
     roads += [Road(f"{j}{n}", j, side) for j in ("J1", "J2") for n in ("N", "S")]
     roads += [Road(f"PX{n}", "PX", FOOTPATH_SPEED_MPS, kind="footpath") for n in ("S", "N")]
     roads += [Road(n, "Z1", side, priority=PRIORITY_ROAD) for n in z1_side]
-    d = params.demand
-    z1_flows = (
-        (Flow("z1_north_south", ("Z1N", "Z1", "Z1S"), d.z1_cross),
-         Flow("z1_south_north", ("Z1S", "Z1", "Z1N"), d.z1_cross))
-        if params.priority_junction
-        else ()
-    )  # fmt: skip
-    flows = (
-        Flow("main_east", EGO_ROUTE_NODES, d.main_east),
-        Flow("main_west", tuple(reversed(EGO_ROUTE_NODES)), d.main_west),
-        Flow("j1_north_south", ("J1N", "J1", "J1S"), d.j1_cross),
-        Flow("j1_south_north", ("J1S", "J1", "J1N"), d.j1_cross),
-        Flow("j2_south_east", ("J2S", "J2", "E0"), d.j2_turn_south),
-        Flow("j2_north_east", ("J2N", "J2", "E0"), d.j2_turn_north),
-        Flow("j2_south_north", ("J2S", "J2", "J2N"), d.j2_cross),
-        Flow("j2_north_south", ("J2N", "J2", "J2S"), d.j2_cross),
-        *z1_flows,
-    )
+    flows = _vehicle_flows(params)
     zebra, j2 = params.zebra_peds_per_hour, params.j2_peds_per_hour
     # pedestrians at J2 walk along the block Z2-J2 from 150 m (at most 3/4 of it) to 50 m
     # (at most half of it) along the edge they start and end on
