@@ -3,6 +3,7 @@ netconvert, a yield line that is a virtual leader while a foe with priority appr
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import subprocess
 from collections.abc import Callable
@@ -124,8 +125,13 @@ def test_the_ego_yields_when_the_foe_arrives_before_it_has_cleared_plus_the_marg
     assert must_yield("g", near, cruising, *ego)  # a permissive turn at a light
     passed = _foe(-9.0, -4.0)  # its front 4 m past the conflict, its back 1 m in it
     gone = _foe(-11.0, -6.0)  # its back 1 m past it
-    assert must_yield("m", passed, cruising, *ego)
     assert not must_yield("m", gone, cruising, *ego)
+    # the ego, standing 10.8 m before the conflict, reaches it in 3 steps (3 + 6 + 9 m):
+    # at 13.89 m/s the foe's back leaves in 1 / 13.89 = 0.07 s, 0.07 + 2 < 3: no need to wait
+    assert not must_yield("m", passed, cruising, *ego)
+    # at 0.3 m/s it leaves in 1 / 0.3 = 3.3 s, 3.3 + 2 > 3: wait; standing, it never leaves
+    assert must_yield("m", passed, dataclasses.replace(cruising, speed_mps=0.3), *ego)
+    assert must_yield("m", passed, dataclasses.replace(cruising, speed_mps=0.0), *ego)
     at_red = FoeMotion(13.89, 2.6, 13.89, 5.0, link_state="r")
     assert not must_yield("m", near, at_red, *ego)
     not_responding = near._replace(ego_responds=False)

@@ -16,8 +16,9 @@ ahead, each foe approaching a conflict with the ego's way, the distances of both
 conflict area and to its end, and whether the ego's link must respond to the foe's
 (``egoResponse``, read from the junction's logic). :func:`must_yield` is the rule: the ego
 yields to a foe when its own link lacks priority, the foe's link is not red, the foe has
-not left the conflict and it will reach it before the ego has left it plus
-:data:`YIELD_MARGIN_S`. The ego's clearing time is what its hardest acceleration
+not left the conflict and will not have left it (at its speed) before the ego reaches it,
+with :data:`YIELD_MARGIN_S` to spare, and it will reach it before the ego has left it plus
+that margin. The ego's clearing time is what its hardest acceleration
 (+3 m/s a step, up to the posted limit) needs to bring its back past the conflict; the
 foe's arrival is the earliest its own acceleration allows (a standing foe counts: it may
 start).
@@ -53,6 +54,8 @@ from explaindrive.env import state as S
 from explaindrive.env.actions import SPEED_CHANGES_MPS, STEP_LENGTH_S, can_stop_before
 from explaindrive.sim.scenario.files import EGO_ID
 
+FOE_MOVING_MPS = 0.1
+"""[m/s] A foe slower than this is standing: it does not leave the conflict on its own."""
 YIELD_JUDGE_GAP_S = 1.0
 """[s] The gap a yield violation breaks: SUMO's default ``jmTimegapMinor``, the time its own
 drivers keep ahead of a prioritised vehicle. The judge is SUMO's rule, so SUMO's drivers are
@@ -171,7 +174,12 @@ def must_yield(
         return False
     if motion.link_state in NO_SIGNAL_STATES:
         return False
-    if foe.foe_exit_m + motion.length_m <= 0.0:  # its back has left the conflict
+    foe_out_m = foe.foe_exit_m + motion.length_m  # until its back has left the conflict
+    if foe_out_m <= 0.0:
+        return False
+    ego_arrives = clear_time_s(foe.ego_dist_m, ego_speed_mps, ego_limit_mps)
+    foe_leaves = foe_out_m / motion.speed_mps if motion.speed_mps > FOE_MOVING_MPS else math.inf
+    if foe_leaves + margin_s <= ego_arrives:  # it will be gone before the ego comes
         return False
     ego_clear = clear_time_s(foe.ego_exit_m + ego_length_m, ego_speed_mps, ego_limit_mps)
     foe_arrives = arrival_time_s(
