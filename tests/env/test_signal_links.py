@@ -1,6 +1,8 @@
 """Signals read per lane and per link: the stop line and signal index of the link the ego
 will use, on joined clusters (one programme for several junctions) too; and SUMO's own
-Krauss driver, whose safety checks are on, runs no red light on any network of the tests."""
+Krauss driver, whose safety checks are on, runs no red light, crosses no yield line in front
+of a foe with priority and collides with nothing on any network of the tests (a network
+built from OpenStreetMap among them)."""
 
 from __future__ import annotations
 
@@ -19,6 +21,8 @@ from explaindrive.sim.sumo_home import sumo_binary
 from tests.conftest import GRID_WITH_LIGHTS
 
 pytestmark = pytest.mark.slow  # SUMO episodes
+
+OSM_TOWN = Path(__file__).parent / "data" / "town.osm.xml"
 
 # A road from W to E crosses a dual carriageway: a northbound one-way road at J1 and a
 # southbound one at J2, 40 m apart. One programme, "C", runs both junctions (a joined
@@ -85,6 +89,18 @@ def random_joined(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+@pytest.fixture(scope="module")
+def osm_town(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A small town written as OpenStreetMap for the tests (``data/town.osm.xml``): Main
+    Street (primary, 50 km/h) crosses Signal Lane at a traffic signal and Give Way Road
+    (residential, 30 km/h) at a priority junction, built by netconvert as any OSM extract."""
+    out = tmp_path_factory.mktemp("osm") / "town.net.xml"
+    subprocess.run([sumo_binary("netconvert"), "--osm-files", str(OSM_TOWN), "--no-turnarounds",
+                    "true", "--geometry.remove", "true", "-o", str(out)],
+                   check=True, capture_output=True)  # fmt: skip
+    return out
+
+
 def joined_routes(net_file: Path, n: int) -> list[tuple[str, str]]:
     """``n`` routes (drawn with a fixed seed) whose shortest paths pass a joined cluster."""
     import sumolib
@@ -147,7 +163,9 @@ def test_each_stop_line_of_a_joined_cluster_is_read_with_its_own_link(
     assert on_j1j2 and info["arrived"]
 
 
-def network_cases(dual: Path, rand: Path, netgen: Callable[..., Path]) -> list[dict[str, object]]:
+def network_cases(
+    dual: Path, rand: Path, town: Path, netgen: Callable[..., Path]
+) -> list[dict[str, object]]:
     """Env configs of every network of the tests, with routes through their lights."""
     two_lane = netgen("grid", *GRID_WITH_LIGHTS, "--default.lanenumber", "2")
     spider = netgen("spider", "--spider.arm-number", "5", "--spider.circle-number", "3",
@@ -160,28 +178,33 @@ def network_cases(dual: Path, rand: Path, netgen: Callable[..., Path]) -> list[d
         {"net_file": two_lane, "route": ("A0B0", "D3D4")},
         {"net_file": spider, "route": ("D1C1", "C3D3")},
         {"net_file": dual, "route": ("WJ1", "J2E")},
+        # Main Street through the signal and over the priority junction (the major road)
+        {"net_file": town, "route": ("10#0", "10#2")},
+        # Give Way Road turning onto Main Street: a minor link, the ego must yield
+        {"net_file": town, "route": ("30#0", "10#2")},
     ]
     cases += [{"net_file": rand, "route": route} for route in joined_routes(rand, 4)]
     return cases
 
 
-def test_sumo_krauss_runs_no_red_light_on_any_network_of_the_tests(
+def test_sumo_krauss_runs_no_red_light_and_yields_on_any_network_of_the_tests(
     make_env: Callable[..., UrbanDriveEnv],
     netgen: Callable[..., Path],
     dual_carriageway: Path,
     random_joined: Path,
+    osm_town: Path,
 ) -> None:
     flagged, episodes = [], 0
-    for case in network_cases(dual_carriageway, random_joined, netgen):
+    for case in network_cases(dual_carriageway, random_joined, osm_town, netgen):
         env = make_env(ego_model="krauss", max_steps=400, warmup_s=100, **case)
         for seed in (0, 1):
             env.reset(seed=seed)
             episodes += 1
             for _ in range(400):
                 _obs, _r, terminated, truncated, info = env.step(3)
-                if info["red_light_run"]:
-                    flagged.append((env.scenario.name, seed, info["time_s"]))
+                if info["red_light_run"] or info["yield_violation"] or info["collision"]:
+                    flagged.append((env.scenario.name, seed, info["time_s"], info["site"]))
                 if terminated or truncated:
                     break
-    assert episodes == 20
+    assert episodes == 24
     assert flagged == []
