@@ -6,11 +6,17 @@ not installed says which, on one line, with exit status 1. Imports of the comman
 a second or more (torch, matplotlib); a Ctrl+C or a SIGTERM in that time, or in a command
 without its own handling, ends the program with one line naming the signal and status
 128 + its number, never a traceback. Later signals, while the program is already
-stopping, are noted and do nothing.
+stopping, are noted and do nothing. After a signal (taken here or by the command, which
+then ends with 128 + its number) the program leaves once its own clean-up (every
+``finally`` on the way out) has run, without the interpreter's
+finalization: an extension interrupted while it was being imported can leave a native
+thread behind that aborts the finalization ("PyThreadState_Get: the function must be
+called with the GIL held"), which would turn status 130 into a crash.
 """
 
 from __future__ import annotations
 
+import os
 import sys
 from types import FrameType
 
@@ -70,4 +76,8 @@ def main() -> None:
     if received:  # this handler took the signal: no command reported it
         print(f"error: stopped by {signal_label(received[0])}", file=sys.stderr)
         code = exit_status(received[0])
+    if code in {exit_status(sig) for sig in HANDLED_SIGNALS}:  # stopped by a signal
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(int(code))  # no finalization (module docstring)
     sys.exit(code)
