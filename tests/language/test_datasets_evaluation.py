@@ -166,6 +166,9 @@ def test_bad_files(tmp_path) -> None:  # type: ignore[no-untyped-def]
     p.write_text("words\nhello\n")
     with pytest.raises(ValueError, match="expected a CSV header with a text column"):
         load_commands(p)
+    p.write_text("text,label\n")
+    with pytest.raises(ValueError, match=r"c.csv: no rows"):
+        load_commands(p)
     j = tmp_path / "d.jsonl"
     j.write_text('{"request": "fast"\n')
     with pytest.raises(ValueError, match=r"d.jsonl:1: not valid JSON"):

@@ -114,12 +114,7 @@ class StateRecord(BaseModel):
         return self.state.within(cutoff_m)
 
     @classmethod
-    def from_observation(
-        cls,
-        obs: NDArray[np.floating],
-        action_change_mps: int,
-        history: RideHistory | None = None,
-    ) -> StateRecord:
+    def from_observation(cls, obs: NDArray[np.floating], action_change_mps: int) -> StateRecord:
         """Build a record from the env's raw (not normalised) 8-dim observation.
 
         Distances at or beyond ``SENSOR_RANGE_M`` become ``None``. A leader that sits
@@ -129,7 +124,6 @@ class StateRecord(BaseModel):
         Args:
             obs: observation in ``explaindrive.env.state.STATE_NAMES`` order.
             action_change_mps: the speed change chosen for this step, -3..3 [m/s].
-            history: what the passenger has felt up to this step, if a ride keeps it.
 
         Raises:
             ValueError: on a wrong shape or an out-of-range value.
@@ -158,7 +152,6 @@ class StateRecord(BaseModel):
                     tl_state=colour.label if colour is not None else None,  # type: ignore[arg-type]
                     d_cross=round(s.d_cross, 1) if cross else None,
                 ),
-                history=history,
             )
         except ValidationError as exc:
             raise ValueError(f"observation does not make a valid state record: {exc}") from exc

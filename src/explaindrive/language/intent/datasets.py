@@ -48,8 +48,10 @@ def load_commands(path: str | Path) -> list[CommandExample]:
     """
     p = Path(path)
     rows = read_lines(p)
-    columns = set(rows[0]) if rows else set()
-    if not rows or not {"text", "label"} <= columns:
+    if not rows:
+        raise ValueError(f"{p}: no rows")
+    columns = set(rows[0])
+    if not {"text", "label"} <= columns:
         raise ValueError(f"{p}: expected a CSV header with columns text,label[,kind][,split]")
     out: list[CommandExample] = []
     for line, row in enumerate(rows, start=2):
