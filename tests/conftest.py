@@ -88,6 +88,29 @@ def netgen(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., Path]:
     return build
 
 
+NO_DEMAND = "<routes>\n</routes>\n"
+"""A demand file with no vehicle (a test adds its own)."""
+
+
+def plain_net(folder: Path, name: str, nodes: str, edges: str, connections: str = "") -> Path:
+    """``folder/name.net.xml``, built by netconvert from plain-XML nodes, edges and (if
+    given) connections, without turnarounds."""
+    import subprocess
+
+    from explaindrive.sim.sumo_home import sumo_binary
+
+    files = [("--node-files", "n.nod.xml", nodes), ("--edge-files", "e.edg.xml", edges)]
+    if connections:
+        files.append(("--connection-files", "c.con.xml", connections))
+    args = [sumo_binary("netconvert"), "--no-turnarounds", "true"]
+    for option, file_name, text in files:
+        (folder / file_name).write_text(text)
+        args += [option, str(folder / file_name)]
+    out = folder / f"{name}.net.xml"
+    subprocess.run([*args, "-o", str(out)], check=True, capture_output=True)
+    return out
+
+
 GRID_WITH_LIGHTS = ("--grid.number", "5", "--grid.length", "200",
                     "--default-junction-type", "traffic_light")  # fmt: skip
 """A 5x5 grid of 200 m blocks whose junctions all have lights."""

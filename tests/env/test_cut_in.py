@@ -10,7 +10,6 @@ number below is worked out by hand from the speeds: SUMO moves a car by its new 
 
 from __future__ import annotations
 
-import subprocess
 from collections.abc import Callable
 from pathlib import Path
 
@@ -21,7 +20,7 @@ from explaindrive.env.actions import action_index
 from explaindrive.env.metrics import EpisodeMetrics
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.sim.scenario.files import EGO_ID
-from explaindrive.sim.sumo_home import sumo_binary
+from tests.conftest import NO_DEMAND, plain_net
 
 NODES = """<nodes>
   <node id="A" x="0" y="0" type="priority"/>
@@ -46,14 +45,8 @@ CHANGES = [3, 3, 3, 3, 0, 0, 0, -3, -3, 0, 0, 0, 0, 0]
 def two_lane_road(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     """An 800 m + 200 m straight road, two lanes a way at 13.89 m/s, and no demand."""
     folder = tmp_path_factory.mktemp("two_lane_road")
-    (folder / "n.nod.xml").write_text(NODES)
-    (folder / "e.edg.xml").write_text(EDGES)
-    (folder / "empty.rou.xml").write_text("<routes>\n</routes>\n")
-    out = folder / "road.net.xml"
-    subprocess.run([sumo_binary("netconvert"), "--node-files", str(folder / "n.nod.xml"),
-                    "--edge-files", str(folder / "e.edg.xml"), "--no-turnarounds", "true",
-                    "-o", str(out)], check=True, capture_output=True)  # fmt: skip
-    return out, folder / "empty.rou.xml"
+    (folder / "empty.rou.xml").write_text(NO_DEMAND)
+    return plain_net(folder, "road", NODES, EDGES), folder / "empty.rou.xml"
 
 
 @pytest.mark.slow

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import subprocess
 from collections.abc import Callable
 from pathlib import Path
 
@@ -26,7 +25,7 @@ from explaindrive.env.right_of_way import (
     must_yield,
 )
 from explaindrive.env.urban_drive import UrbanDriveEnv
-from explaindrive.sim.sumo_home import sumo_binary
+from tests.conftest import NO_DEMAND, plain_net
 
 # A crossroads J of a priority road W-E (priority 3) and a minor road S-N (priority 1), each
 # one lane a way at 13.89 m/s; J is an unsignalised priority junction.
@@ -48,7 +47,6 @@ EDGES = """<edges>
   <edge id="JS" from="J" to="S" priority="1" numLanes="1" speed="13.89"/>
 </edges>"""
 LINE_M = 292.8  # [m] netconvert's length of SJ: the yield line's route position
-NO_DEMAND = "<routes>\n</routes>\n"
 
 
 @pytest.fixture(scope="module")
@@ -56,14 +54,8 @@ def crossroads(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     """The crossroads above, built by netconvert from plain XML, and a demand with no car
     (the foe is added by the test)."""
     folder = tmp_path_factory.mktemp("crossroads")
-    (folder / "n.nod.xml").write_text(NODES)
-    (folder / "e.edg.xml").write_text(EDGES)
     (folder / "empty.rou.xml").write_text(NO_DEMAND)
-    out = folder / "crossroads.net.xml"
-    subprocess.run([sumo_binary("netconvert"), "--node-files", str(folder / "n.nod.xml"),
-                    "--edge-files", str(folder / "e.edg.xml"), "--no-turnarounds", "true",
-                    "-o", str(out)], check=True, capture_output=True)  # fmt: skip
-    return out, folder / "empty.rou.xml"
+    return plain_net(folder, "crossroads", NODES, EDGES), folder / "empty.rou.xml"
 
 
 def test_the_ego_clears_accelerating_hardest_up_to_the_limit() -> None:

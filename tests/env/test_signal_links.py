@@ -18,7 +18,7 @@ from explaindrive.env import state as S
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from explaindrive.sim.route import RouteJunction
 from explaindrive.sim.sumo_home import sumo_binary
-from tests.conftest import GRID_WITH_LIGHTS
+from tests.conftest import GRID_WITH_LIGHTS, plain_net
 
 pytestmark = pytest.mark.slow  # SUMO episodes
 
@@ -65,15 +65,7 @@ LINKS = {"J1J2_0": (6, 16), "J1J2_1": (7, 17)}
 @pytest.fixture(scope="module")
 def dual_carriageway(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The joined cluster above, built by netconvert from plain XML."""
-    folder = tmp_path_factory.mktemp("dual")
-    for name, text in (("n.nod.xml", NODES), ("e.edg.xml", EDGES), ("c.con.xml", CONNECTIONS)):
-        (folder / name).write_text(text)
-    out = folder / "dual.net.xml"
-    subprocess.run([sumo_binary("netconvert"), "--node-files", str(folder / "n.nod.xml"),
-                    "--edge-files", str(folder / "e.edg.xml"), "--connection-files",
-                    str(folder / "c.con.xml"), "--no-turnarounds", "true", "-o", str(out)],
-                   check=True, capture_output=True)  # fmt: skip
-    return out
+    return plain_net(tmp_path_factory.mktemp("dual"), "dual", NODES, EDGES, CONNECTIONS)
 
 
 @pytest.fixture(scope="module")
