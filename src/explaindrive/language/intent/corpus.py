@@ -1,8 +1,8 @@
 """The lines LLM-1 learns from and is calibrated on, read from ``language/data``.
 
 * Requests (``commands_train.csv``): labelled passenger requests; its ``reserve`` split is
-  kept for calibration. The development split ``commands_heldout.csv`` (the previous test
-  split) is trained on whole.
+  kept for calibration. The development splits ``commands_heldout.csv`` and
+  ``commands_heldout2.csv`` (the previous test splits) are trained on whole.
 * Written lines (``commands_written.csv``): in-car chatter and phone talk that use pace and
   stopping words in other senses, questions about the car's behaviour (``why``), answers
   to a confirmation (``yes`` / ``no``), negated requests; one line in seven (by a hash of
@@ -13,7 +13,7 @@
 * The development splits ``commands_test.csv`` and ``commands_blind.csv`` are calibrated on,
   never trained on.
 
-The test split ``commands_heldout2.csv`` and the external check ``everyday_check.csv.gz``
+The test split ``commands_heldout3.csv`` and the external check ``everyday_check.csv.gz``
 are read by the evaluation only.
 """
 
@@ -32,7 +32,7 @@ from explaindrive.language.data import (
     BLIND_CSV,
     EVERYDAY_CHECK,
     EVERYDAY_TRAIN,
-    FIRST_HELDOUT_CSV,
+    FORMER_HELDOUT_CSVS,
     TEST_CSV,
     TRAIN_CSV,
     WRITTEN_CSV,
@@ -98,7 +98,8 @@ def _held_out(text: str) -> bool:
 def training_pool() -> tuple[list[Example], list[Example]]:
     """The labelled lines and the everyday lines (label ``none``) LLM-1 is trained on."""
     labelled = [e for e, row in _labelled(data_path(TRAIN_CSV)) if row.get("split") != RESERVE]
-    labelled += [e for e, _ in _labelled(data_path(FIRST_HELDOUT_CSV))]
+    for name in FORMER_HELDOUT_CSVS:
+        labelled += [e for e, _ in _labelled(data_path(name))]
     labelled += [e for e, _ in _labelled(data_path(WRITTEN_CSV)) if not _held_out(e.text)]
     everyday = [
         Example(row["text"], "none", f"{EVERYDAY_TRAIN}:{row['source']}")
