@@ -42,7 +42,7 @@ log = logging.getLogger(__name__)
 EnvFactory = Callable[[], gym.Env]
 """Builds one environment; must be picklable (a module-level function or a partial)."""
 
-SAFETY_FLAGS: tuple[str, ...] = ("collision", "red_light_run", "ped_violation")
+SAFETY_FLAGS: tuple[str, ...] = ("collision", "red_light_run", "ped_violation", "yield_violation")
 MAX_RESET_ATTEMPTS = 5
 
 

@@ -25,7 +25,7 @@ log = logging.getLogger(__name__)
 
 CSV_FIELDS: tuple[str, ...] = (
     "episode", "env", "seed", "traffic_level", "stops", "return", "length", "env_steps",
-    "epsilon", "collision", "red_light_run", "ped_violation", "speeding_steps",
+    "epsilon", "collision", "red_light_run", "ped_violation", "yield_violation", "speeding_steps",
     "shield_share", "shielded", "mean_speed_mps", "distance_m", "terminated", "truncated",
     "wall_time_s",
 )  # fmt: skip
@@ -79,6 +79,29 @@ def tb_episode(tb: Any, ep: EpisodeSummary, step: int, epsilon: float, sps: floa
         tb.add_scalar(f"safety/{key}", float(value), step)
     tb.add_scalar("safety/speeding_steps", ep.speeding_steps, step)
     tb.add_scalar("safety/shield_share", ep.shield_share, step)
+
+
+def upgrade_csv(path: Path) -> None:
+    """Rewrite an ``episodes.csv`` written with fewer columns than :data:`CSV_FIELDS` (a
+    run resumed across a version that logs more) under the current header; a column it
+    lacks is left empty in its rows.
+
+    Raises:
+        ValueError: if the file has a column :data:`CSV_FIELDS` does not know.
+    """
+    with path.open(newline="") as f:
+        reader = csv.DictReader(f)
+        header = list(reader.fieldnames or [])
+        rows = list(reader)
+    if header == list(CSV_FIELDS):
+        return
+    unknown = [name for name in header if name not in CSV_FIELDS]
+    if unknown:
+        raise ValueError(f"{path}: unknown column {unknown[0]!r}; not a training log")
+    with path.open("w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=CSV_FIELDS, restval="")
+        writer.writeheader()
+        writer.writerows(rows)
 
 
 def truncate_csv(path: Path, rows: int) -> bool:
@@ -212,6 +235,8 @@ class RunLog:
         self.config = config
         csv_path = out_dir / "episodes.csv"
         append = append and csv_path.exists()
+        if append:
+            upgrade_csv(csv_path)
         self._csv_file = csv_path.open("a" if append else "w", newline="")
         self._csv = csv.DictWriter(self._csv_file, fieldnames=CSV_FIELDS)
         if not append:
