@@ -19,6 +19,7 @@ from explaindrive.cli._language_common import (
     load_config,
 )
 from explaindrive.cli._paths import refuse_bad_outputs
+from explaindrive.language.data import DECISIONS_JSONL, EVERYDAY_CHECK, HELDOUT_CSV
 
 score_app = typer.Typer(
     name="score",
@@ -26,10 +27,9 @@ score_app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
 )
-# the shipped files (explaindrive.language.data), named without importing the readers
-SHIPPED_COMMANDS = "the shipped test split commands_heldout.csv"
-SHIPPED_EVERYDAY = "the shipped external check everyday_check.csv.gz"
-SHIPPED_DECISIONS = "the shipped decisions.jsonl"
+SHIPPED_COMMANDS = f"the shipped test split {HELDOUT_CSV}"
+SHIPPED_EVERYDAY = f"the shipped external check {EVERYDAY_CHECK}"
+SHIPPED_DECISIONS = f"the shipped {DECISIONS_JSONL}"
 
 
 def _write(out: Path | None, data: dict[str, Any]) -> None:
@@ -61,7 +61,7 @@ def intents_command(
 ) -> None:
     """Accuracy, macro-F1, kappa, template compliance and per-class figures of LLM-1; with a
     remote model, also the figures each trust_embedded_from would give on its replies."""
-    from explaindrive.language.data import HELDOUT_CSV, data_path
+    from explaindrive.language.data import data_path
     from explaindrive.language.intent.datasets import load_commands
 
     refuse_bad_outputs(files=((out, "--json"),))
@@ -142,7 +142,7 @@ def everyday_command(
 ) -> None:
     """LLM-1 on everyday lines that ask for nothing: the share left without a command and
     the commands given (the external check)."""
-    from explaindrive.language.data import EVERYDAY_CHECK, data_path
+    from explaindrive.language.data import data_path
     from explaindrive.language.intent.corpus import read_lines
 
     refuse_bad_outputs(files=((out, "--json"),))
@@ -197,7 +197,7 @@ def decisions_command(
 ) -> None:
     """Trigger accuracy/precision/recall/F1, factor accuracy and checked explanations of
     LLM-2/LLM-3."""
-    from explaindrive.language.data import DECISIONS_JSONL, data_path
+    from explaindrive.language.data import data_path
     from explaindrive.language.explanation.datasets import load_decisions
 
     refuse_bad_outputs(files=((out, "--json"),))
