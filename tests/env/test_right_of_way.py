@@ -1,5 +1,6 @@
-"""Right of way: the rule's times worked out by hand, and on a priority crossroads built by
-netconvert, a yield line that is a virtual leader while a foe with priority approaches."""
+"""Right of way: the rule's and the judge's times worked out by hand, and on a priority
+crossroads built by netconvert, a yield line that is a virtual leader while a foe with
+priority approaches, and entering the conflict area in front of it a yield violation."""
 
 from __future__ import annotations
 
@@ -14,12 +15,15 @@ import pytest
 from explaindrive.agent.shield import shield
 from explaindrive.env import state as S
 from explaindrive.env.right_of_way import (
+    YIELD_JUDGE_GAP_S,
     YIELD_MARGIN_S,
     FoeMotion,
     JunctionFoe,
     YieldSensor,
     arrival_time_s,
     clear_time_s,
+    enters_in_front,
+    foe_window_s,
     junction_of,
     link_yields,
     must_yield,
@@ -85,8 +89,9 @@ def test_link_states_and_junction_ids() -> None:
 
 
 def test_foes_are_looked_for_up_to_the_last_yielding_link_before_an_unregulated_one() -> None:
-    lines = [("A", 50.0), ("B", 120.0), ("U", 150.0), ("C", 180.0)]
-    sensor = YieldSensor(lines, 5.0, unregulated=frozenset({"U"}))
+    junctions = [("A", 50.0, 60.0), ("B", 120.0, 132.0), ("U", 150.0, 159.0),
+                 ("C", 180.0, 191.0)]  # fmt: skip
+    sensor = YieldSensor(junctions, 5.0, unregulated=frozenset({"U"}))
     links = [("x", True, True, False, f":{j}_0_0", state, "s", length)
              for j, state, length in (("A", "M", 10.0), ("B", "m", 12.0), ("U", "M", 9.0),
                                       ("C", "m", 11.0))]  # fmt: skip
@@ -95,6 +100,22 @@ def test_foes_are_looked_for_up_to_the_last_yielding_link_before_an_unregulated_
     # from 160 m, past U: C's line 20 m ahead
     assert sensor.horizon(links, 160.0) == ({"C": "m"}, 20.0 + 11.0 + 1.0)
     assert sensor.horizon(links[:1], 20.0) == ({}, 0.0)  # nothing yields: no look-up
+
+
+def test_foes_are_looked_for_in_a_junction_entered_by_a_yielding_link() -> None:
+    junctions = [("A", 50.0, 60.0), ("B", 120.0, 132.0), ("U", 150.0, 159.0)]
+    sensor = YieldSensor(junctions, 5.0, unregulated=frozenset({"U"}))
+    links = [("x", True, True, False, f":{j}_0_0", state, "s", length)
+             for j, state, length in (("A", "M", 10.0), ("B", "m", 12.0),
+                                      ("U", "M", 9.0))]  # fmt: skip
+    assert sensor.horizon(links, 40.0) == ({"B": "m"}, 80.0 + 12.0 + 1.0)
+    # past B's line, inside B (its link read as "m" before the line): to its end at 132 m
+    # and a metre; U lies beyond
+    assert sensor.horizon(links[2:], 125.0) == ({"B": "m"}, 132.0 - 125.0 + 1.0)
+    # inside A, whose link had priority: nothing to look for there
+    assert sensor.horizon(links[1:], 55.0) == ({"B": "m"}, 65.0 + 12.0 + 1.0)
+    assert sensor.passing(55.0) is None
+    assert sensor.passing(132.0) is None  # on the edge out of B
 
 
 def _foe(foe_dist_m: float, foe_exit_m: float, ego_exit_m: float = 14.0) -> JunctionFoe:
@@ -128,6 +149,49 @@ def test_the_ego_yields_when_the_foe_arrives_before_it_has_cleared_plus_the_marg
     assert not must_yield("m", near, at_red, *ego)
     not_responding = near._replace(ego_responds=False)
     assert not must_yield("m", not_responding, cruising, *ego)
+
+
+def _conflict(ego_dist_m: float, foe_dist_m: float, foe_exit_m: float) -> JunctionFoe:
+    """A conflict area 6 m long on the ego's way (its end 6 m after its start)."""
+    return JunctionFoe("foe", ego_dist_m, foe_dist_m, ego_dist_m + 6.0, foe_exit_m,
+                       ":J_7_0", ":J_10_0", True, False)  # fmt: skip
+
+
+def test_a_foe_keeping_its_speed_reaches_and_leaves_the_conflict() -> None:
+    at_12 = FoeMotion(12.0, 2.6, 13.89, 5.0)
+    # 48 m to the area, 54 m to its end and 5 m of car: in at 48 / 12 = 4 s, out at 59 / 12
+    assert foe_window_s(_conflict(2.0, 48.0, 54.0), at_12) == (4.0, 59.0 / 12.0)
+    assert foe_window_s(_conflict(2.0, -1.0, 5.0), at_12) == (0.0, 10.0 / 12.0)  # inside
+    assert foe_window_s(_conflict(2.0, -12.0, -6.0), at_12) == (0.0, 0.0)  # gone
+    standing = dataclasses.replace(at_12, speed_mps=0.05)
+    assert foe_window_s(_conflict(2.0, 3.0, 9.0), standing) == (math.inf, math.inf)
+    assert foe_window_s(_conflict(2.0, -1.0, 5.0), standing) == (0.0, math.inf)
+
+
+def test_entering_the_conflict_in_front_of_a_foe_with_priority_is_a_violation() -> None:
+    at_12 = FoeMotion(12.0, 2.6, 13.89, 5.0)
+    # the ego's front, 2 m before the area, travels 4 m this step (4 m/s): it enters at
+    # 2 / 4 = 0.5 s, and its back (5 m) leaves the 6 m area at (2 + 6 + 5) / 4 = 3.25 s;
+    # a foe at 12 m/s breaks the 1 s gap if it arrives before 4.25 s: from under 51 m
+    assert YIELD_JUDGE_GAP_S == 1.0
+    assert enters_in_front(_conflict(2.0, 50.0, 56.0), at_12, 4.0, 5.0)  # 4.17 s
+    assert not enters_in_front(_conflict(2.0, 52.0, 58.0), at_12, 4.0, 5.0)  # 4.33 s
+    # no entry this step: still 0.1 m short of the area, or already in it before the step
+    assert not enters_in_front(_conflict(2.0, 50.0, 56.0), at_12, 1.9, 5.0)
+    assert not enters_in_front(_conflict(0.0, 50.0, 56.0), at_12, 4.0, 5.0)
+    # a foe inside, its back out at 9 / 12 = 0.75 s, after the ego's entry at 0.5 s
+    assert enters_in_front(_conflict(2.0, -1.0, 4.0), at_12, 4.0, 5.0)
+    # its back out at 4 / 12 = 0.33 s, before the ego's entry: it has left
+    assert not enters_in_front(_conflict(2.0, -6.0, -1.0), at_12, 4.0, 5.0)
+    # standing before the area, it does not count; standing inside, it does
+    standing = dataclasses.replace(at_12, speed_mps=0.0)
+    assert not enters_in_front(_conflict(2.0, 3.0, 9.0), standing, 4.0, 5.0)
+    assert enters_in_front(_conflict(2.0, -1.0, 4.0), standing, 4.0, 5.0)
+    # a foe at red, or one the ego's link need not yield to
+    at_red = dataclasses.replace(at_12, link_state="r")
+    assert not enters_in_front(_conflict(2.0, 50.0, 56.0), at_red, 4.0, 5.0)
+    no_priority = _conflict(2.0, 50.0, 56.0)._replace(ego_responds=False)
+    assert not enters_in_front(no_priority, at_12, 4.0, 5.0)
 
 
 def _drive(env: UrbanDriveEnv, foe_at_step: int, steps: int = 70) -> list[dict[str, float]]:
@@ -205,9 +269,12 @@ def test_entering_in_front_of_the_foe_is_a_yield_violation(
             flagged.append((before, env.route_pos_m))
         if terminated or truncated:
             break
-    # 35.1 m after 4 steps, then 13 m a step: the line at 292.8 m is crossed once, in the
-    # step from 282.1 m to 295.1 m, 20 steps later
-    assert flagged == [(pytest.approx(282.1), pytest.approx(295.1))]
+    # 35.1 m after 4 steps, then 13 m a step: the line at 292.8 m is crossed in the step
+    # from 282.1 m to 295.1 m; the conflict area with the foe's lane starts 4 m past it and
+    # is 3.2 m long (SUMO's distances), and is entered in the next step, to 308.1 m: 1.7 m
+    # into the step's 13 m, the ego's back out (1.7 + 3.2 + 5) / 13 = 0.76 s after the
+    # step's start, the foe, 20.1 m away at 14.3 m/s, in at 1.40 s: within 1 s
+    assert flagged == [(pytest.approx(295.1), pytest.approx(308.1))]
 
 
 @pytest.mark.slow

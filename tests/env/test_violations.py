@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from explaindrive.env.perception import CrossingSensor, SignalLink
+from explaindrive.env.right_of_way import Conflict, FoeMotion, JunctionFoe
 from explaindrive.env.violations import ViolationJudge, Violations, ego_collided, speeding
 from explaindrive.sim.route import RouteGeometry, RouteJunction
 from tests.env.fake_sumo import FakeSumo
@@ -21,12 +22,13 @@ JUNCTIONS = (
     RouteJunction("Z", 250.0, 262.0, signalized=False, crossing=True),
     RouteJunction("P", 400.0, 410.0, signalized=False, crossing=False),
 )
+EGO_LENGTH_M = 5.0  # [m]
 GEOMETRY = RouteGeometry(("a", "b"), (0.0, 112.0), 600.0, (0.0,), (13.89,), (), (ZEBRA,),
                          JUNCTIONS)  # fmt: skip
 
 
 def judge() -> ViolationJudge:
-    return ViolationJudge(CrossingSensor((ZEBRA,), {":Z_c0": LANE}), GEOMETRY)
+    return ViolationJudge(CrossingSensor((ZEBRA,), {":Z_c0": LANE}), GEOMETRY, EGO_LENGTH_M)
 
 
 def test_crossing_a_red_stop_line_is_a_run_and_a_green_one_is_not() -> None:
@@ -70,6 +72,22 @@ def test_each_step_has_the_site_of_its_violations_or_of_the_ego() -> None:
     assert judge()(red, 95.0, 115.0, LINKS[:1], {}) == Violations(True, False, "signal")
     ped = judge()(empty, 245.0, 265.0, (), {":Z_c0": True})
     assert ped == Violations(False, True, "crossing")
+
+
+def test_entering_a_conflict_area_in_front_of_a_foe_is_a_yield_violation() -> None:
+    # at P, a conflict area 2 m past the ego's front before the step and 6 m long; the foe
+    # at 12 m/s, 50 m from it: the ego entering at 4 m/s clears it (with its 5 m) at
+    # 13 / 4 = 3.25 s, the foe arrives at 50 / 12 = 4.17 s, within 1 s of it
+    foe = JunctionFoe("car", 2.0, 50.0, 8.0, 56.0, ":P_1_0", ":P_4_0", True, False)
+    conflict = Conflict(foe, FoeMotion(12.0, 2.6, 13.89, 5.0))
+    api = FakeSumo()
+    step = judge()(api, 396.0, 400.0, (), {}, (conflict,))
+    assert step == Violations(False, False, "yield_junction", yield_violation=True)
+    # 1.9 m: the front stops short of the area
+    assert not judge()(api, 396.0, 397.9, (), {}, (conflict,)).yield_violation
+    # the foe 60 m away arrives at 5 s, 1.75 s after the ego has left
+    far = Conflict(foe._replace(foe_dist_m=60.0, foe_exit_m=66.0), conflict.motion)
+    assert not judge()(api, 396.0, 400.0, (), {}, (far,)).yield_violation
 
 
 def test_collisions_and_speeding() -> None:

@@ -21,7 +21,7 @@ Definitions:
     travel time  seconds until the ego left the route (None if it did not)
     ride         the ride-quality figures (free-road speed, hard brakes, reversals, jerk
                  percentiles, standstill gaps): :mod:`explaindrive.env.ride_quality`
-    yield viol.  yield lines crossed while a foe with priority was within the gap
+    yield viol.  conflict areas entered in front of a foe with priority, within the gap
                  (:mod:`explaindrive.env.violations`)
     violations   collisions + red-light runs + pedestrian-yield violations + yield
                  violations + speeding steps (:attr:`EpisodeResult.violations`)
@@ -101,7 +101,7 @@ class EpisodeResult:
     """Site -> kind -> count (module docstring); empty for an episode stored before sites
     were recorded."""
     yield_violations: int = 0
-    """Yield lines crossed while a foe with priority was within the gap
+    """Conflict areas entered in front of a foe with priority, within the gap
     (:mod:`explaindrive.env.violations`); in :attr:`violations` and split by site like the
     other kinds (0 for an episode stored before it was counted)."""
 

@@ -11,7 +11,9 @@ turn, a merge: :mod:`explaindrive.env.right_of_way`) puts a virtual leader at it
 as a red light does; the observation keeps its 8 dimensions.
 
 Each sensor is a small object that reads the running simulation and returns a value; none
-writes episode state. :class:`Perception` combines them into a :class:`Percept`.
+writes episode state (the yield sensor remembers the ego's link into each junction it
+approached, to read the foes while the ego passes it). :class:`Perception` combines them
+into a :class:`Percept`.
 """
 
 from __future__ import annotations
@@ -93,8 +95,8 @@ class Percept:
         crossings: the crossings ahead.
         light_colour: the true colour of the next light (the observation may show a yellow
             the ego goes through as green, :meth:`AmberDecision.shown_colour`).
-        yields: the yield lines where the ego must let a foe pass
-            (:class:`~explaindrive.env.right_of_way.YieldSensor`).
+        yields: the yield lines where the ego must let a foe pass, and the conflict areas
+            it may enter next (:class:`~explaindrive.env.right_of_way.YieldSensor`).
     """
 
     obs: NDArray[np.float32]
@@ -316,8 +318,8 @@ class Perception:
         self.geometry = geometry
         self.leaders = leaders
         self.crossings = CrossingSensor(geometry.crossings, crossing_lanes)
-        lines = ((j.node_id, j.start_m) for j in geometry.junctions)
-        self.yields = YieldSensor(lines, ego_length_m, unregulated)
+        junctions = ((j.node_id, j.start_m, j.end_m) for j in geometry.junctions)
+        self.yields = YieldSensor(junctions, ego_length_m, unregulated)
 
     def __call__(
         self,

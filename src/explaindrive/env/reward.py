@@ -241,8 +241,9 @@ def traffic_rules_reward(
     (the paper: +r_respect) for a stop at a red light or for a pedestrian.
 
     Args:
-        violation: a red light was run, a pedestrian crossing was violated or a yield line
-            was crossed before a foe with priority (a yield violation) in this step.
+        violation: a red light was run, a pedestrian crossing was violated or a conflict
+            area was entered in front of a foe with priority (a yield violation) in this
+            step.
         stopped: the ego stands still after the step.
         stop_reason: why standing still is justified: ``"signal"`` (red/yellow light or
             pedestrian, i.e. the virtual leader), ``"queue"`` (a real vehicle close

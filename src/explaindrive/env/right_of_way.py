@@ -36,11 +36,24 @@ and braking would only leave it in the conflict (the yellow light's dilemma zone
 is none either: SUMO's drivers wait inside a junction for a left turn at its internal
 junction, which the ego does not model.
 
-``getJunctionFoes`` is asked only when a yielding link lies within sensor range, and only as
-far as the last such link: SUMO 1.28's libsumo crashes (a segmentation fault) when its
-look-ahead reaches an ``unregulated`` junction (one without junction logic, such as the
-centre of netgenerate's spider networks), so the look-ahead also stops before the first one
-on the route; a yielding link beyond it is read once the ego has passed it.
+The judge of yield violations (:func:`enters_in_front`) reads the conflict area itself, as
+traffic-safety practice does with the post-encroachment time: the ego breaks the right of
+way when its front enters a conflict area during a step (the area's start, seen before the
+step, lies within the step's travel) while a foe with priority (``egoResponse``, its link not
+red) has not left the area and will reach it before the ego's back has left it plus SUMO's
+own gap, :data:`YIELD_JUDGE_GAP_S`. Both times are at the speeds they drive (no hardest
+acceleration here): the ego's over the step, the foe's as read before it; a standing foe
+that has not entered never arrives, one standing inside never leaves. SUMO's drivers may
+cross the stop line and wait short of the conflict (inside the junction for a left turn)
+until their own gap rule lets them in, which is no violation: only the entry into the area
+is judged, and only at a link that yields.
+
+``getJunctionFoes`` is asked only when a yielding link lies within sensor range or the ego
+is inside a junction it entered by one, and only as far as the last such link: SUMO 1.28's
+libsumo crashes (a segmentation fault) when its look-ahead reaches an ``unregulated``
+junction (one without junction logic, such as the centre of netgenerate's spider networks),
+so the look-ahead also stops before the first one on the route; a yielding link beyond it
+is read once the ego has passed it.
 """
 
 from __future__ import annotations
@@ -57,9 +70,10 @@ from explaindrive.sim.scenario.files import EGO_ID
 FOE_MOVING_MPS = 0.1
 """[m/s] A foe slower than this is standing: it does not leave the conflict on its own."""
 YIELD_JUDGE_GAP_S = 1.0
-"""[s] The gap a yield violation breaks: SUMO's default ``jmTimegapMinor``, the time its own
-drivers keep ahead of a prioritised vehicle. The judge is SUMO's rule, so SUMO's drivers are
-not flagged for what they are built to do; the ego perceives with :data:`YIELD_MARGIN_S`."""
+"""[s] The gap a yield violation breaks: a foe with priority reaching the conflict area less
+than this after the ego's back has left it. SUMO's default ``jmTimegapMinor``, the time its
+own drivers keep ahead of a prioritised vehicle, so SUMO's drivers are not flagged for what
+they are built to do; the ego perceives with :data:`YIELD_MARGIN_S`."""
 YIELD_MARGIN_S = 2.0
 """[s] A foe with priority must reach the conflict at least this long after the ego has left
 it: SUMO's default ``jmTimegapMinor`` (1 s), the gap its Krauss drivers keep ahead of a
@@ -156,9 +170,9 @@ def must_yield(
     ego_speed_mps: float,
     ego_limit_mps: float,
     ego_length_m: float,
-    margin_s: float = YIELD_MARGIN_S,
 ) -> bool:
-    """The rule (module docstring): whether the ego must let ``foe`` pass before it enters.
+    """The rule (module docstring): whether the ego must let ``foe`` pass before it enters,
+    with :data:`YIELD_MARGIN_S` to spare.
 
     Args:
         ego_link_state: the state of the ego's link into the junction.
@@ -167,73 +181,130 @@ def must_yield(
         ego_speed_mps: the ego's speed.
         ego_limit_mps: the ego's posted limit (its top speed through the junction).
         ego_length_m: the ego's length.
-        margin_s: the gap the foe must arrive after the ego has cleared the conflict:
-            :data:`YIELD_MARGIN_S` to perceive, :data:`YIELD_JUDGE_GAP_S` to judge.
     """
     if not link_yields(ego_link_state) or not foe.ego_responds:
         return False
     if motion.link_state in NO_SIGNAL_STATES:
         return False
-    foe_out_m = foe.foe_exit_m + motion.length_m  # until its back has left the conflict
-    if foe_out_m <= 0.0:
+    if foe.foe_exit_m + motion.length_m <= 0.0:  # its back has left the conflict
         return False
     ego_arrives = clear_time_s(foe.ego_dist_m, ego_speed_mps, ego_limit_mps)
-    foe_leaves = foe_out_m / motion.speed_mps if motion.speed_mps > FOE_MOVING_MPS else math.inf
-    if foe_leaves + margin_s <= ego_arrives:  # it will be gone before the ego comes
+    _arrives, foe_leaves = foe_window_s(foe, motion)
+    if foe_leaves + YIELD_MARGIN_S <= ego_arrives:  # it will be gone before the ego comes
         return False
     ego_clear = clear_time_s(foe.ego_exit_m + ego_length_m, ego_speed_mps, ego_limit_mps)
     foe_arrives = arrival_time_s(
         foe.foe_dist_m, motion.speed_mps, motion.accel_mps2, motion.max_speed_mps
     )
-    return foe_arrives < ego_clear + margin_s
+    return foe_arrives < ego_clear + YIELD_MARGIN_S
+
+
+def foe_window_s(foe: JunctionFoe, motion: FoeMotion) -> tuple[float, float]:
+    """[s] When ``foe``, keeping its speed, reaches the conflict area and when its back has
+    left it (``0`` for what is behind it; a standing foe, slower than
+    :data:`FOE_MOVING_MPS`, never reaches it and never leaves it)."""
+
+    def at_speed(distance_m: float) -> float:
+        if distance_m <= 0.0:
+            return 0.0
+        return distance_m / motion.speed_mps if motion.speed_mps > FOE_MOVING_MPS else math.inf
+
+    return at_speed(foe.foe_dist_m), at_speed(foe.foe_exit_m + motion.length_m)
+
+
+def enters_in_front(
+    foe: JunctionFoe, motion: FoeMotion, travelled_m: float, ego_length_m: float
+) -> bool:
+    """The judge (module docstring): whether the ego, whose front travels ``travelled_m``
+    during a step that starts with ``foe`` as read, enters their conflict area in front of a
+    foe with priority over its link.
+
+    The ego drives the step at ``travelled_m`` per :data:`STEP_LENGTH_S` (SUMO moves a car
+    by its new speed); the times count from the step's start.
+
+    Args:
+        foe: the foe and the conflict, read before the step.
+        motion: the foe's speed, length and link state, read before the step.
+        travelled_m: how far the ego's front moved during the step.
+        ego_length_m: the ego's length.
+    """
+    if not 0.0 < foe.ego_dist_m <= travelled_m:  # no entry this step
+        return False
+    if not foe.ego_responds or motion.link_state in NO_SIGNAL_STATES:
+        return False
+    ego_speed_mps = travelled_m / STEP_LENGTH_S
+    ego_enters = foe.ego_dist_m / ego_speed_mps
+    ego_leaves = (foe.ego_exit_m + ego_length_m) / ego_speed_mps
+    foe_arrives, foe_leaves = foe_window_s(foe, motion)
+    return foe_leaves > ego_enters and foe_arrives < ego_leaves + YIELD_JUDGE_GAP_S
+
+
+class Conflict(NamedTuple):
+    """A conflict area the ego may enter in the coming step, and a foe with priority over its
+    link there (read before the step, for :func:`enters_in_front`)."""
+
+    foe: JunctionFoe
+    motion: FoeMotion
 
 
 class YieldReading(NamedTuple):
-    """The yield lines ahead this step [m] from the ego's front (sensor range: none).
+    """The yield lines and conflict areas ahead this step.
 
     Attributes:
-        leader_gap_m: to the nearest where the ego must yield and can still stop: a
-            virtual leader.
-        due_gap_m: to the nearest where a foe with priority is within SUMO's own gap
-            (:data:`YIELD_JUDGE_GAP_S`), whether or not the ego can still stop (what the
-            yield-violation judge reads).
+        leader_gap_m: [m] from the ego's front to the nearest yield line where the ego must
+            yield and can still stop: a virtual leader (sensor range: none).
+        conflicts: the conflict areas at links that yield which the ego's front may enter in
+            the coming step (at most its speed plus its hardest acceleration ahead), each with
+            a foe whose link has priority over the ego's (what the yield-violation judge
+            reads).
     """
 
     leader_gap_m: float = S.SENSOR_RANGE_M
-    due_gap_m: float = S.SENSOR_RANGE_M
+    conflicts: tuple[Conflict, ...] = ()
 
 
 NO_YIELD = YieldReading()
-"""The reading with no yield line in force."""
+"""The reading with no yield line in force and no conflict ahead."""
 
 
 class YieldSensor:
-    """The yield lines ahead where the ego must let a foe pass this step.
+    """The yield lines ahead where the ego must let a foe pass this step, and the conflict
+    areas it may enter.
 
     Args:
-        lines: ``(junction id, route position of its stop line [m])`` of the route's
-            junctions, in route order.
+        junctions: ``(junction id, route position of its stop line [m], route position of
+            the edge out of it [m])`` of the route's junctions, in route order.
         ego_length_m: the ego's length [m].
         unregulated: the ids of the route's ``unregulated`` junctions (module docstring).
     """
 
     def __init__(
         self,
-        lines: Iterable[tuple[str, float]],
+        junctions: Iterable[tuple[str, float, float]],
         ego_length_m: float,
         unregulated: frozenset[str] = frozenset(),
     ) -> None:
-        self.lines = tuple(lines)
+        self.junctions = tuple(junctions)
         self.ego_length_m = ego_length_m
         self.unregulated = unregulated
         self._types: dict[str, tuple[float, float]] = {}  # foe id -> (accel, length)
+        self._link_states: dict[str, str] = {}  # junction -> the ego's link, last read ahead
 
     def line_gap(self, junction: str, pos_m: float) -> float | None:
         """[m] from route position ``pos_m`` to the stop line of the next passage through
         ``junction`` (``None``: none ahead)."""
-        for node, line_m in self.lines:
+        for node, line_m, _end_m in self.junctions:
             if node == junction and line_m >= pos_m:
                 return line_m - pos_m
+        return None
+
+    def passing(self, pos_m: float) -> tuple[str, float] | None:
+        """The junction route position ``pos_m`` lies in, past its stop line, if the ego's
+        link into it yielded when last read before the line: its id and where it ends [m]."""
+        for node, line_m, end_m in self.junctions:
+            if line_m < pos_m < end_m:
+                state = self._link_states.get(node, "")
+                return (node, end_m) if link_yields(state) else None
         return None
 
     def foe_motion(self, api: Any, foe: JunctionFoe) -> FoeMotion:
@@ -255,11 +326,17 @@ class YieldSensor:
         )  # fmt: skip
 
     def horizon(self, links: Iterable[Any], pos_m: float) -> tuple[dict[str, str], float]:
-        """The yielding links among ``links`` (``vehicle.getNextLinks``, in route order)
-        within sensor range and before the first unregulated junction: junction id -> link
-        state, and how far to look for their foes [m] (to the end of the last one)."""
+        """The yielding links of the junction the ego is passing (:meth:`passing`) and among
+        ``links`` (``vehicle.getNextLinks``, in route order) within sensor range and before
+        the first unregulated junction: junction id -> link state, and how far to look for
+        their foes [m] (to the end of the last one). Each link's state is kept for
+        :meth:`passing`."""
         states: dict[str, str] = {}
         reach = 0.0
+        inside = self.passing(pos_m)
+        if inside is not None:
+            states[inside[0]] = self._link_states[inside[0]]
+            reach = inside[1] - pos_m + 1.0  # [m] to its end, and a metre
         for link in links:
             junction, state = junction_of(link[4]), link[5]
             gap = self.line_gap(junction, pos_m)
@@ -267,6 +344,7 @@ class YieldSensor:
                 continue
             if gap >= S.SENSOR_RANGE_M or junction in self.unregulated:
                 break
+            self._link_states[junction] = state
             if link_yields(state):
                 states[junction] = state
                 reach = gap + float(link[7]) + 1.0  # [m] its whole length, and a metre
@@ -274,27 +352,28 @@ class YieldSensor:
 
     def __call__(self, api: Any, pos_m: float, speed_mps: float, limit_mps: float) -> YieldReading:
         """The yield lines ahead of the ego's front (at route position ``pos_m``) where it
-        must yield now (:func:`must_yield`): the nearest it can still stop before (a leader)
-        and the nearest of all."""
+        must yield now (:func:`must_yield`), the nearest it can still stop before being a
+        leader, and the conflict areas it may enter in the coming step with a foe that has
+        priority (for :func:`enters_in_front`)."""
         states, reach = self.horizon(api.vehicle.getNextLinks(EGO_ID), pos_m)
         if not states:
             return NO_YIELD
-        foes = api.vehicle.getJunctionFoes(EGO_ID, reach)
-        leader = due = S.SENSOR_RANGE_M
-        for raw in foes:
+        entry_reach_m = (speed_mps + MAX_ACCEL_MPS) * STEP_LENGTH_S  # the most a step covers
+        leader, conflicts = S.SENSOR_RANGE_M, []
+        for raw in api.vehicle.getJunctionFoes(EGO_ID, reach):
             foe = JunctionFoe(*raw)
             junction = junction_of(foe.ego_lane)
             state = states.get(junction)
-            if state is None or not link_yields(state) or not foe.ego_responds:
+            if state is None or not foe.ego_responds:
                 continue
+            motion = None
+            if 0.0 < foe.ego_dist_m <= entry_reach_m:
+                motion = self.foe_motion(api, foe)
+                conflicts.append(Conflict(foe, motion))
             gap = self.line_gap(junction, pos_m)
-            if gap is None or gap >= leader:
+            if gap is None or gap >= leader or not can_stop_before(speed_mps, gap):
                 continue
-            motion = self.foe_motion(api, foe)
-            args = (state, foe, motion, speed_mps, limit_mps, self.ego_length_m)
-            if must_yield(*args):
-                if can_stop_before(speed_mps, gap):
-                    leader = gap
-                if must_yield(*args, margin_s=YIELD_JUDGE_GAP_S):
-                    due = min(due, gap)
-        return YieldReading(leader, due)
+            motion = motion or self.foe_motion(api, foe)
+            if must_yield(state, foe, motion, speed_mps, limit_mps, self.ego_length_m):
+                leader = gap
+        return YieldReading(leader, tuple(conflicts))

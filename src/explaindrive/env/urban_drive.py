@@ -197,7 +197,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             schedule=list(opts.command_schedule),
             start_pos_m=entry.start_pos_m,
             perception=perception,
-            judge=ViolationJudge(perception.crossings, self.geometry),
+            judge=ViolationJudge(perception.crossings, self.geometry, entry.length_m),
             pedestrians=PedestrianSource(int(sumo_seed), self.scenario.pedestrian_flows),
             amber=AmberDecision.for_rule(self.config.yellow_leader),
             noise=opts.noise if opts.noise is not None else self.config.noise,
@@ -245,7 +245,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         # violations are judged on what the ego saw before this step's observation
         assert seen is not None  # set by reset
         violations = ep.judge(self._sumo.api, prev_pos, ep.pos_m, seen.links,
-                              seen.crossings.in_lane, seen.yields.due_gap_m)  # fmt: skip
+                              seen.crossings.in_lane, seen.yields.conflicts)  # fmt: skip
         ep.speed_mps, ep.accel_mps2 = motion.speed_mps, accel
         ep.apply_schedule()
         obs, leader, real = self._next_observation(motion, prev_obs)

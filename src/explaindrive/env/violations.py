@@ -1,14 +1,16 @@
 """The ego's violations in one step: collision, red-light run, pedestrian yield, right of
 way, speeding.
 
-Red lights and crossings are judged on what the ego saw before the step's observation: a
-violation is crossing a stop line during the step while the light was red, or while a
-pedestrian was in, or stepping into, the ego's lane on the crossing. A light is judged on
-the link the ego perceived (:func:`~explaindrive.env.perception.signal_links`): the stop
-line and signal index of its lane's link, as the observation reads them. A yield violation
-is crossing a yield line during the step while, before it, a foe with priority was within
-the gap of :mod:`explaindrive.env.right_of_way` (whether or not the ego could still stop
-there: a foe seen too late counts too).
+Red lights, crossings and the right of way are judged on what the ego saw before the
+step's observation: a violation is crossing a stop line during the step while the light was
+red, or while a pedestrian was in, or stepping into, the ego's lane on the crossing. A light
+is judged on the link the ego perceived (:func:`~explaindrive.env.perception.signal_links`):
+the stop line and signal index of its lane's link, as the observation reads them. A yield
+violation is the ego's front entering, during the step, a conflict area of a junction it
+entered by a link that yields, in front of a foe with priority that had not left the area
+and would reach it, at its speed, within SUMO's own gap after the ego's back has left it
+(:func:`~explaindrive.env.right_of_way.enters_in_front`; whether or not the ego could still
+stop: a foe seen too late counts too).
 
 Each step has a site (:data:`~explaindrive.env.metrics.SITES`), where its violations are
 counted: a red-light run at its signal; a pedestrian-yield violation at its crossing's
@@ -25,7 +27,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from explaindrive.env.perception import CrossingSensor, SignalLink, link_colour
-from explaindrive.env.state import SENSOR_RANGE_M, LightState
+from explaindrive.env.right_of_way import Conflict, enters_in_front
+from explaindrive.env.state import LightState
 from explaindrive.sim.route import RouteCrossing, RouteGeometry
 from explaindrive.sim.scenario.files import EGO_ID
 
@@ -44,7 +47,7 @@ def speeding(speed_mps: float, legal_limit_mps: float) -> bool:
 
 @dataclass(slots=True)  # built every step: not frozen (a frozen __init__ costs 5x as much)
 class Violations:
-    """The stop-line violations of one step and the step's site (one of
+    """The traffic-rule violations of one step and the step's site (one of
     :data:`~explaindrive.env.metrics.SITES`)."""
 
     red_light_run: bool
@@ -54,22 +57,26 @@ class Violations:
 
     @property
     def any(self) -> bool:
-        """A stop line was violated: a red-light run, a pedestrian-yield or a yield violation
+        """A rule of way was broken: a red-light run, a pedestrian-yield or a yield violation
         (what the reward's traffic term charges)."""
         return self.red_light_run or self.ped_violation or self.yield_violation
 
 
 class ViolationJudge:
-    """Judges the ego's passage over the stop lines of its route.
+    """Judges the ego's passage over the stop lines and through the junctions of its route.
 
     Args:
         crossings: the crossing sensor of the episode.
         geometry: the route's geometry (its junctions give the sites).
+        ego_length_m: the ego's length [m] (how long its back takes to leave a conflict).
     """
 
-    def __init__(self, crossings: CrossingSensor, geometry: RouteGeometry) -> None:
+    def __init__(
+        self, crossings: CrossingSensor, geometry: RouteGeometry, ego_length_m: float
+    ) -> None:
         self.crossings = crossings
         self.geometry = geometry
+        self.ego_length_m = ego_length_m
 
     def __call__(
         self,
@@ -78,14 +85,14 @@ class ViolationJudge:
         pos_m: float,
         links: tuple[SignalLink, ...],
         in_lane: dict[str, bool],
-        yield_due_m: float = SENSOR_RANGE_M,
+        conflicts: tuple[Conflict, ...] = (),
     ) -> Violations:
         """The violations of a step that moved the ego's front from ``prev_pos_m`` to
-        ``pos_m`` (route positions [m]); ``links``, ``in_lane`` and ``yield_due_m`` (the
-        nearest yield line in force, ``YieldReading.due_gap_m``) are what the ego perceived
+        ``pos_m`` (route positions [m]); ``links``, ``in_lane`` and ``conflicts`` (the
+        conflict areas it might enter, ``YieldReading.conflicts``) are what the ego perceived
         before the step (:class:`~explaindrive.env.perception.Percept`)."""
         red = self.ran_red_light(api, links, pos_m - prev_pos_m)
-        yielded = not (yield_due_m < SENSOR_RANGE_M and 0.0 <= yield_due_m < pos_m - prev_pos_m)
+        cut_in = self.entered_in_front(conflicts, pos_m - prev_pos_m)
         ped = self.crossed_occupied(api, prev_pos_m, pos_m, in_lane)
         if red:
             site = "signal"
@@ -94,7 +101,15 @@ class ViolationJudge:
             site = "signal" if crossing is not None and crossing.signalized else "crossing"
         else:
             site = self.site_at(pos_m)
-        return Violations(red, ped, site, yield_violation=not yielded)
+        return Violations(red, ped, site, yield_violation=cut_in)
+
+    def entered_in_front(self, conflicts: tuple[Conflict, ...], travelled_m: float) -> bool:
+        """The ego's front, travelling ``travelled_m`` this step, entered one of
+        ``conflicts`` in front of its foe with priority
+        (:func:`~explaindrive.env.right_of_way.enters_in_front`)."""
+        return any(
+            enters_in_front(c.foe, c.motion, travelled_m, self.ego_length_m) for c in conflicts
+        )
 
     def site_at(self, pos_m: float) -> str:
         """The site of route position ``pos_m`` (module docstring)."""

@@ -74,7 +74,7 @@ class Aggregate:
     crossing_stop_gap_mean_m: float | None = None
     stop_gap_in_window_share: float | None = None
     yield_violations: int = 0
-    """Yield lines crossed while a foe with priority was within the gap, in total."""
+    """Conflict areas entered in front of a foe with priority, within the gap, in total."""
     violations_by_site: dict[str, dict[str, int]] = field(default_factory=dict)
     """Site -> kind -> total (:data:`~explaindrive.env.metrics.VIOLATION_KINDS`)."""
 
