@@ -36,6 +36,38 @@ def test_from_observation_keeps_objects_and_drops_virtual_leader() -> None:
     assert virt.state.d_lead is None and virt.state.dv is None and virt.request == "stop"
 
 
+def test_from_observation_drops_the_leader_on_the_yield_line() -> None:
+    # the env's virtual leader at a yield line 14.0 m ahead, seen (with noise) at 14.2 m
+    held = _obs(0, 6, 13.9, 14.2, 6, 200, 0, 200)
+    rec = StateRecord.from_observation(held, -2, yield_gap_m=14.04)
+    assert (rec.state.d_lead, rec.state.dv, rec.state.d_yield) == (None, None, 14.0)
+    # without the yield reading the same observation reads as a standing car
+    plain = StateRecord.from_observation(held, -2)
+    assert (plain.state.d_lead, plain.state.dv, plain.state.d_yield) == (14.2, 6.0, None)
+    # the sensor range is no yield line
+    assert StateRecord.from_observation(held, -2, yield_gap_m=200.0).state.d_yield is None
+
+
+def test_a_car_before_the_yield_line_stays_a_car() -> None:
+    # |14.2 - 16.3| = 2.1 m > the 2 m tolerance: a real car 2.1 m before the line
+    rec = StateRecord.from_observation(_obs(0, 6, 13.9, 14.2, 1, 200, 0, 200), -1, yield_gap_m=16.3)
+    assert (rec.state.d_lead, rec.state.dv, rec.state.d_yield) == (14.2, 1.0, 16.3)
+
+
+def test_json_without_d_yield_still_reads_and_unknown_keys_are_refused() -> None:
+    old = '{"request": "fast", "action": 0, "state": {"v_ego": 1, "v_lim": 10, "d_cross": null}}'
+    assert StateRecord.from_json(old).state.d_yield is None
+    given = '{"request": "fast", "action": -1, "state": {"v_ego": 5, "v_lim": 10, "d_yield": 9}}'
+    assert StateRecord.from_json(given).state.d_yield == 9.0
+    with pytest.raises(ValueError, match="d_give_way"):
+        StateRecord.from_json(
+            '{"request": "fast", "action": 0, "state": {"v_ego": 1, "v_lim": 10, "d_give_way": 9}}'
+        )
+    # beyond the 50 m cut-off a yield line is left out, as any object
+    far = '{"request": "fast", "action": -1, "state": {"v_ego": 5, "v_lim": 10, "d_yield": 51}}'
+    assert StateRecord.from_json(far).nearby().d_yield is None
+
+
 def test_from_observation_rejects_bad_action_and_shape() -> None:
     with pytest.raises(ValueError):
         StateRecord.from_observation(_obs(0, 8, 13.9, 200, 0, 200, 0, 200), 5)

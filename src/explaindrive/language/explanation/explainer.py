@@ -6,6 +6,7 @@ import hashlib
 import re
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from typing import Any
 
 from explaindrive.language.explanation.decision import (
     Factor,
@@ -217,8 +218,12 @@ _CLOSERS: dict[Factor, tuple[str, ...]] = {
 
 
 def _phrasing_key(record: StateRecord) -> str:
-    """What picks a record's phrasing: its step, not its history."""
-    return record.model_dump_json(exclude={"history"})
+    """What picks a record's phrasing: its step, not its history (a record without a yield
+    line is keyed as before ``d_yield`` existed, so its phrasing stays the same)."""
+    exclude: dict[str, Any] = {"history": True}
+    if record.state.d_yield is None:
+        exclude["state"] = {"d_yield"}
+    return record.model_dump_json(exclude=exclude)
 
 
 def _pick(options: tuple[str, ...], key: str) -> str:
