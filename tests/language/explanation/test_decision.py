@@ -82,7 +82,9 @@ def test_parse_tag() -> None:
 
 @pytest.mark.parametrize("factor", list(Factor))
 def test_template_names_only_its_factor(factor: Factor) -> None:
-    r = rec("comfort", -3, d_tl=30.0, tl_state="red", d_cross=20.0, d_lead=9.0, dv=2.0)
+    r = rec(
+        "comfort", -3, d_tl=30.0, tl_state="red", d_cross=20.0, d_lead=9.0, dv=2.0, d_yield=14.0
+    )
     e = TemplateExplainer().explain(r, factor)
     assert mentioned_factors(e.text) == {factor}
     assert check_grounding(e.text, factor, r).ok

@@ -42,6 +42,7 @@ class Factor(StrEnum):
     TRAFFIC_LIGHT = "traffic_light"
     PEDESTRIAN = "pedestrian"
     LEAD_VEHICLE = "lead_vehicle"
+    GIVE_WAY = "give_way"  # a junction where a foe with priority passes first
     SPEED_LIMIT = "speed_limit"
 
 

@@ -227,7 +227,8 @@ def environment_summary(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M)
     Objects farther than ``cutoff_m`` are left out. The objects present are listed by
     urgency (:func:`~explaindrive.language.explanation.hazards.braking_hazards`: the one the car has
     to brake for first leads), and a last sentence names the most urgent reason to slow
-    down, with the figure that makes it urgent.
+    down, with the figure that makes it urgent. A light, a leader and a crossing that are
+    absent are said to be; a junction where the car must give way is named only when it is.
 
     Example:
         ``Ego speed 8.0 m/s (29 km/h); speed limit 13.9 m/s (50 km/h); urban area.
@@ -246,6 +247,7 @@ def environment_summary(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M)
         "lead_vehicle": _lead_sentence(s),
         "traffic_light": _light_sentence(s),
         "pedestrian": _crossing_sentence(s),
+        "give_way": _yield_sentence(s),
     }
     order = sorted(present, key=lambda f: urgent.index(f) if f in urgent else len(urgent))
     parts += [present[f] for f in order if present[f] is not None]  # type: ignore[misc]
@@ -255,7 +257,7 @@ def environment_summary(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M)
         "traffic_light": f"No traffic light within {limit}.",
         "pedestrian": f"No pedestrian crossing within {limit}.",
     }
-    parts += [absent[f] for f in order if present[f] is None]
+    parts += [absent[f] for f in order if present[f] is None and f in absent]
     if hazards:
         parts.append(f"Most urgent: {_urgency_phrase(s, hazards[0])}.")
     return " ".join(parts)
@@ -306,6 +308,12 @@ def _crossing_sentence(s: RecordState) -> str | None:
     return f"Pedestrian crossing the street {s.d_cross:.0f} m ahead."
 
 
+def _yield_sentence(s: RecordState) -> str | None:
+    if s.d_yield is None:
+        return None
+    return f"Junction in {s.d_yield:.0f} m where we must give way: a car with priority is coming."
+
+
 def _urgency_phrase(s: RecordState, hazard: Hazard) -> str:
     """What makes ``hazard`` urgent, in words ("the red traffic light 15 m ahead (...)")."""
     need = f"a comfortable stop needs {stopping_distance_m(s.v_ego):.0f} m"
@@ -313,6 +321,8 @@ def _urgency_phrase(s: RecordState, hazard: Hazard) -> str:
         return f"the {s.tl_state} traffic light {s.d_tl:.0f} m ahead ({need})"
     if hazard.factor is Factor.PEDESTRIAN:
         return f"the pedestrian crossing {s.d_cross:.0f} m ahead ({need})"
+    if hazard.factor is Factor.GIVE_WAY:
+        return f"giving way at the junction {s.d_yield:.0f} m ahead ({need})"
     if hazard.factor is Factor.LEAD_VEHICLE:
         ttc = ttc_s(s)
         timing = (
