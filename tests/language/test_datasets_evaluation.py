@@ -186,7 +186,6 @@ def test_intent_metrics_by_hand() -> None:
     assert m["confusion"]["matrix"][2] == [0, 0, 1, 1]
 
 
-@pytest.mark.xfail(strict=True, reason="the rules do not read d_yield yet (y001-y010)")
 def test_decisions_on_shipped_set_meet_targets() -> None:
     cfg = LanguageConfig().embedded
     report = evaluate_decisions(

@@ -69,6 +69,16 @@ def test_a_red_light_that_turned_green_is_no_cause_any_more() -> None:
     assert ex.counts.models["explain"].stale == 1
 
 
+def test_giving_way_is_no_cause_once_the_foe_has_passed() -> None:
+    give_way = Explanation("We're giving way at the junction.", Factor.GIVE_WAY, "embedded")
+    held = explanations(record(d_yield=3.0), steps=3)
+    held.on_explanation(ExplainJob(0), give_way, 1.5)
+    assert held.counts.models["explain"].stale == 0 and held.counts.explanations == 1
+    passed = explanations(record(), steps=3)
+    passed.on_explanation(ExplainJob(0), give_way, 1.5)
+    assert passed.counts.models["explain"].stale == 1 and passed.counts.explanations == 0
+
+
 def test_module_counts_put_a_veto_before_a_fallback() -> None:
     c = ModuleCounts()
     c.add(fallback=False, vetoed=False)

@@ -135,6 +135,20 @@ def test_summary_lists_the_hazard_that_forces_the_action_first() -> None:
     assert "Most urgent" not in environment_summary(standing)
 
 
+def test_summary_names_the_junction_where_the_car_gives_way() -> None:
+    rec = StateRecord.model_validate(
+        {"request": "fast", "action": -2, "state": {"v_ego": 8, "v_lim": 13.9, "d_yield": 20}}
+    )
+    # the line 20 m ahead is the only hazard; a comfortable stop from 8 m/s needs 8^2 / 4 = 16 m
+    assert environment_summary(rec) == (
+        "Ego speed 8.0 m/s (29 km/h); speed limit 13.9 m/s (50 km/h); urban area. "
+        "Junction in 20 m where we must give way: a car with priority is coming. "
+        "No vehicle ahead within 50 m. No traffic light within 50 m. "
+        "No pedestrian crossing within 50 m. "
+        "Most urgent: giving way at the junction 20 m ahead (a comfortable stop needs 16 m)."
+    )
+
+
 def test_history_summary_in_words() -> None:
     from explaindrive.language.explanation.summary import history_summary
 
