@@ -198,7 +198,7 @@ def _drive(env: UrbanDriveEnv, foe_at_step: int, steps: int = 70) -> list[dict[s
     """Drive the ego by the shield, asking for the fastest change (a SUMO baseline ego drives
     itself); a foe enters the priority road at its start, at 13.89 m/s, after
     ``foe_at_step`` steps. One row a step; the last one's ``t`` is the arrival time [s]."""
-    obs, _ = env.reset(seed=0)
+    obs, info = env.reset(seed=0)
     api = env.sumo
     api.route.add("major", ["WJ", "JE"])
     rows = []
@@ -210,7 +210,8 @@ def _drive(env: UrbanDriveEnv, foe_at_step: int, steps: int = 70) -> list[dict[s
         foe_road = api.vehicle.getRoadID("foe") if "foe" in api.vehicle.getIDList() else ""
         rows.append({"pos": env.route_pos_m, "v": float(obs[S.V_EGO]),
                      "lead": float(obs[S.D_LEAD]), "dv": float(obs[S.DV]),
-                     "yield": seen.yields.leader_gap_m, "foe_on_je": foe_road == "JE",
+                     "yield": seen.yields.leader_gap_m, "info_yield": info["yield_gap_m"],
+                     "foe_on_je": foe_road == "JE",
                      "foe_gone": foe_road in ("JE", ""),
                      "yield_violation": False})  # fmt: skip
         decision = shield(obs, np.arange(7, dtype=np.float64))  # the fastest safe change
@@ -235,6 +236,7 @@ def test_a_yield_line_holds_the_ego_while_a_foe_with_priority_approaches(
     rows = _drive(env, foe_at_step=3)
     held = [r for r in rows if r["yield"] < S.SENSOR_RANGE_M]
     assert held, "the yield line was never a leader"
+    assert all(r["info_yield"] == r["yield"] for r in rows)  # info gives what was perceived
     for r in held:  # a standing virtual leader at the line: gap to the line, dv = own speed
         assert r["yield"] == pytest.approx(LINE_M - r["pos"], abs=1e-6)
         assert r["lead"] == pytest.approx(LINE_M - r["pos"], abs=1e-3)

@@ -21,7 +21,7 @@ from explaindrive.language.data import (
 )
 from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
 from explaindrive.language.explanation.datasets import load_decisions
-from explaindrive.language.explanation.explainer import present_factors
+from explaindrive.language.explanation.explainer import Factor, present_factors
 from explaindrive.language.intent.corpus import near_copies, read_lines
 from explaindrive.language.intent.datasets import (
     RESERVE_SPLIT,
@@ -139,11 +139,13 @@ def test_training_splits_keep_file_order_and_number_the_dev_splits(tmp_path) -> 
 
 def test_decision_set() -> None:
     rows = load_decisions(data_path(DECISIONS_JSONL))
-    assert len(rows) == 135
-    assert sum(r.explain for r in rows) == 82
+    assert len(rows) == 146
+    assert sum(r.explain for r in rows) == 90
     with_history = [r for r in rows if r.history is not None]
-    assert len(with_history) == 19  # what a passenger notices over several steps
-    assert sum(r.explain for r in with_history) == 9
+    assert len(with_history) == 20  # what a passenger notices over several steps
+    assert sum(r.explain for r in with_history) == 10
+    giving_way = [r for r in rows if r.state.d_yield is not None]
+    assert len(giving_way) == 11 and sum(r.factor is Factor.GIVE_WAY for r in giving_way) == 6
     several = [r for r in rows if r.explain and len(present_factors(r.record().nearby())) >= 3]
     assert len(several) >= 30  # the speed limit and at least two objects
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 from types import SimpleNamespace
 from typing import Any
 
+import numpy as np
+
 from explaindrive.language.explanation.decision import Factor
 from explaindrive.language.explanation.explainer import Explanation
 from explaindrive.language.explanation.summary import StateRecord
@@ -67,9 +69,30 @@ def test_a_red_light_that_turned_green_is_no_cause_any_more() -> None:
     assert ex.counts.models["explain"].stale == 1
 
 
+def test_giving_way_is_no_cause_once_the_foe_has_passed() -> None:
+    give_way = Explanation("We're giving way at the junction.", Factor.GIVE_WAY, "embedded")
+    held = explanations(record(d_yield=3.0), steps=3)
+    held.on_explanation(ExplainJob(0), give_way, 1.5)
+    assert held.counts.models["explain"].stale == 0 and held.counts.explanations == 1
+    passed = explanations(record(), steps=3)
+    passed.on_explanation(ExplainJob(0), give_way, 1.5)
+    assert passed.counts.models["explain"].stale == 1 and passed.counts.explanations == 0
+
+
 def test_module_counts_put_a_veto_before_a_fallback() -> None:
     c = ModuleCounts()
     c.add(fallback=False, vetoed=False)
     c.add(fallback=True, vetoed=False)
     c.add(fallback=True, vetoed=True)  # a rejected reply: the template stood in
     assert c == ModuleCounts(used=1, fallback=1, vetoed=1)
+
+
+def test_the_state_record_holds_the_yield_line_seen_with_the_observation() -> None:
+    ex = explanations(record(), steps=1)
+    # fast, 6 m/s on a 13.9 m/s road, the virtual leader at the yield line 12.5 m ahead
+    seen = np.array([0, 6.0, 13.9, 12.5, 6.0, 200.0, 0, 200.0], dtype=np.float32)
+    held = ex.state_record(seen, -2, yield_gap_m=12.5)
+    assert (held.state.d_lead, held.state.d_yield, held.action) == (None, 12.5, -2)
+    assert held.history is not None and held.history.slow_s == 1.0  # 6 <= 13.9 - 3
+    free = ex.state_record(seen, -2, yield_gap_m=200.0)  # no line in force: a standing car
+    assert (free.state.d_lead, free.state.d_yield) == (12.5, None)

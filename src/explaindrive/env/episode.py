@@ -67,6 +67,12 @@ class Episode:
         return self.seen.light_colour if self.seen is not None else S.LightState.GREEN
 
     @property
+    def yield_gap_m(self) -> float:
+        """[m] to the yield line the latest perception holds the ego at as a virtual leader
+        (``YieldReading.leader_gap_m``; the sensor range: none)."""
+        return self.seen.yields.leader_gap_m if self.seen is not None else S.SENSOR_RANGE_M
+
+    @property
     def time_s(self) -> float:
         """Seconds since the ego entered."""
         return self.steps * STEP_LENGTH_S
@@ -175,6 +181,7 @@ class StepRecord:
             "light_gap_m": float(obs[S.D_TL]),
             "light_state": ep.light_colour.label,
             "crossing_gap_m": float(obs[S.D_CROSS]),
+            "yield_gap_m": ep.yield_gap_m,
             "distance_m": ep.pos_m - ep.start_pos_m,
             "collision": self.motion.collided,
             "red_light_run": self.violations.red_light_run,

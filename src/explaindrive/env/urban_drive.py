@@ -74,6 +74,9 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
     ``info["action_mask"]`` after ``reset`` and ``step``, and :meth:`action_masks` at any
     time, give the 7 actions the run-time shield allows in the true state
     (:func:`explaindrive.env.safety.runtime_mask`), as masked-action learners expect.
+    ``info["yield_gap_m"]`` after ``reset`` and ``step`` is the gap to the yield line where
+    the ego must give way, held as a virtual leader in the observation returned with it
+    (:mod:`explaindrive.env.right_of_way`; the sensor range, 200 m: none).
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 1}  # noqa: RUF012
@@ -214,6 +217,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             "seed": int(sumo_seed),
             "time_s": 0.0,
             "distance_m": 0.0,
+            "yield_gap_m": ep.yield_gap_m,
             "action_mask": self.action_masks(),
         }
         if ep.noise.active:

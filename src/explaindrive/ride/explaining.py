@@ -62,10 +62,14 @@ class Explanations:
         self._now: tuple[int, StateRecord] | None = None  # the newest step and its state
         self.history = HistoryTracker()
 
-    def state_record(self, seen: NDArray[Any], change: int) -> StateRecord:
+    def state_record(
+        self, seen: NDArray[Any], change: int, yield_gap_m: float | None = None
+    ) -> StateRecord:
         """The newest step's record for LLM-2 and LLM-3: what the driver saw (``seen``, the
-        raw observation), its speed change and the ride's history, updated by this step."""
-        record = StateRecord.from_observation(seen, change)
+        raw observation, and ``yield_gap_m``, the yield line perceived with it: the env's
+        ``info["yield_gap_m"]``), its speed change and the ride's history, updated by this
+        step."""
+        record = StateRecord.from_observation(seen, change, yield_gap_m=yield_gap_m)
         history = self.history.update(record.state.v_ego, record.state.v_lim)
         return record.model_copy(update={"history": history})
 

@@ -90,6 +90,7 @@ class RideSession:
         self.records: list[StepRecord] = []
         self._inbox: list[dict[str, Any]] = []  # passenger events of the coming step
         self._obs: NDArray[np.float32] | None = None
+        self._yield_gap_m: float | None = None  # perceived with _obs (info["yield_gap_m"])
         self.done = False
         self.requests = PassengerRequests(
             config, self.lane, language, controller, self.env, self.counts, self._note,
@@ -101,10 +102,10 @@ class RideSession:
     # ------------------------------------------------------------------ lifecycle
     def start(self, command: Command = Command.FAST) -> NDArray[np.float32]:
         """Reset the environment; the ride starts under ``command``."""
-        obs, _ = self.env.reset(seed=self.config.seed, options={"command": command.label})
+        obs, info = self.env.reset(seed=self.config.seed, options={"command": command.label})
         self.controller.begin(self.env.config.obs_noise[1])  # the sensor it drives with
         self.controller.follow(self.env)
-        self._obs = obs
+        self._obs, self._yield_gap_m = obs, float(info["yield_gap_m"])
         self.done = False
         return obs
 
@@ -222,9 +223,10 @@ class RideSession:
         )
         self._inbox = []
         self.records.append(record)
-        self._obs = next_obs
+        yield_gap_m = self._yield_gap_m  # the yield line seen with `seen`
+        self._obs, self._yield_gap_m = next_obs, float(info["yield_gap_m"])
         self.done = terminated or truncated
-        state_record = self.explanations.state_record(seen, change)
+        state_record = self.explanations.state_record(seen, change, yield_gap_m)
         if command is not Command.STOP or change > 0:
             self.explanations.submit_decision(record, state_record)
         if self.done:

@@ -82,7 +82,9 @@ def test_parse_tag() -> None:
 
 @pytest.mark.parametrize("factor", list(Factor))
 def test_template_names_only_its_factor(factor: Factor) -> None:
-    r = rec("comfort", -3, d_tl=30.0, tl_state="red", d_cross=20.0, d_lead=9.0, dv=2.0)
+    r = rec(
+        "comfort", -3, d_tl=30.0, tl_state="red", d_cross=20.0, d_lead=9.0, dv=2.0, d_yield=14.0
+    )
     e = TemplateExplainer().explain(r, factor)
     assert mentioned_factors(e.text) == {factor}
     assert check_grounding(e.text, factor, r).ok
@@ -126,6 +128,48 @@ def test_the_hazard_that_forces_the_action_is_named() -> None:
     assert rule_decision(rec("fast", -2, d_tl=30.0, tl_state="red", d_cross=15.0)).factor is (
         Factor.PEDESTRIAN
     )
+
+
+def test_braking_for_a_yield_line_is_giving_way() -> None:
+    # 8 m/s, the line 20 m ahead: slack (20 - 8^2 / 4) / 8 = 0.5 s
+    braking = rec("fast", -2, v_ego=8.0, d_yield=20.0)
+    d = rule_decision(braking)
+    assert d.explain and d.factor is Factor.GIVE_WAY and d.conflict is Conflict.SLOWS
+    assert [(h.factor, h.slack_s) for h in braking_hazards(braking.nearby())] == [
+        (Factor.GIVE_WAY, 0.5)
+    ]
+    # the line 15 m ahead (-1.0 s) before a red light at the next junction 40 m ahead (1.5 s)
+    both = rec("fast", -2, d_yield=15.0, d_tl=40.0, tl_state="red")
+    assert [(h.factor, h.slack_s) for h in braking_hazards(both.nearby())] == [
+        (Factor.GIVE_WAY, -1.0),
+        (Factor.TRAFFIC_LIGHT, 1.5),
+    ]
+    # a stopped car 6 m ahead at 4 m/s: (6 - 2 - 4^2 / 4) / 4 = 0 s, before the line: 2.5 s
+    queue = rec("fast", -2, v_ego=4.0, d_lead=6.0, dv=4.0, d_yield=14.0)
+    assert rule_decision(queue).factor is Factor.LEAD_VEHICLE
+
+
+def test_what_needs_no_explanation_at_a_yield_line() -> None:
+    assert not rule_decision(rec("comfort", -1, v_ego=8.0, d_yield=20.0)).explain
+    assert not rule_decision(rec("stop", -2, v_ego=8.0, d_yield=20.0)).explain
+    far = rule_decision(rec("fast", -1, d_yield=60.0))  # beyond the 50 m cut-off
+    assert not far.explain and far.conflict is Conflict.SLOWS
+
+
+def test_a_wait_at_a_yield_line_is_giving_way() -> None:
+    waiting = StateRecord.model_validate(
+        {
+            "request": "comfort",
+            "action": 0,
+            "state": {"v_ego": 0.0, "v_lim": 13.9, "d_yield": 2.5},
+            "history": {"slow_s": 8.0, "stopped_s": 6.0},
+        }
+    )
+    d = rule_decision(waiting)
+    assert d.explain and d.factor is Factor.GIVE_WAY and d.conflict is Conflict.WAITS
+    # nearest first: the line 8 m ahead, then a red light 30 m ahead
+    s = rec("fast", 0, d_yield=8.0, d_tl=30.0, tl_state="red").nearby()
+    assert holding_factors(s) == [Factor.GIVE_WAY, Factor.TRAFFIC_LIGHT]
 
 
 def test_a_waiting_car_ranks_what_is_nearest() -> None:

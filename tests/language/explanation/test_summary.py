@@ -36,6 +36,38 @@ def test_from_observation_keeps_objects_and_drops_virtual_leader() -> None:
     assert virt.state.d_lead is None and virt.state.dv is None and virt.request == "stop"
 
 
+def test_from_observation_drops_the_leader_on_the_yield_line() -> None:
+    # the env's virtual leader at a yield line 14.0 m ahead, seen (with noise) at 14.2 m
+    held = _obs(0, 6, 13.9, 14.2, 6, 200, 0, 200)
+    rec = StateRecord.from_observation(held, -2, yield_gap_m=14.04)
+    assert (rec.state.d_lead, rec.state.dv, rec.state.d_yield) == (None, None, 14.0)
+    # without the yield reading the same observation reads as a standing car
+    plain = StateRecord.from_observation(held, -2)
+    assert (plain.state.d_lead, plain.state.dv, plain.state.d_yield) == (14.2, 6.0, None)
+    # the sensor range is no yield line
+    assert StateRecord.from_observation(held, -2, yield_gap_m=200.0).state.d_yield is None
+
+
+def test_a_car_before_the_yield_line_stays_a_car() -> None:
+    # |14.2 - 16.3| = 2.1 m > the 2 m tolerance: a real car 2.1 m before the line
+    rec = StateRecord.from_observation(_obs(0, 6, 13.9, 14.2, 1, 200, 0, 200), -1, yield_gap_m=16.3)
+    assert (rec.state.d_lead, rec.state.dv, rec.state.d_yield) == (14.2, 1.0, 16.3)
+
+
+def test_json_without_d_yield_still_reads_and_unknown_keys_are_refused() -> None:
+    old = '{"request": "fast", "action": 0, "state": {"v_ego": 1, "v_lim": 10, "d_cross": null}}'
+    assert StateRecord.from_json(old).state.d_yield is None
+    given = '{"request": "fast", "action": -1, "state": {"v_ego": 5, "v_lim": 10, "d_yield": 9}}'
+    assert StateRecord.from_json(given).state.d_yield == 9.0
+    with pytest.raises(ValueError, match="d_give_way"):
+        StateRecord.from_json(
+            '{"request": "fast", "action": 0, "state": {"v_ego": 1, "v_lim": 10, "d_give_way": 9}}'
+        )
+    # beyond the 50 m cut-off a yield line is left out, as any object
+    far = '{"request": "fast", "action": -1, "state": {"v_ego": 5, "v_lim": 10, "d_yield": 51}}'
+    assert StateRecord.from_json(far).nearby().d_yield is None
+
+
 def test_from_observation_rejects_bad_action_and_shape() -> None:
     with pytest.raises(ValueError):
         StateRecord.from_observation(_obs(0, 8, 13.9, 200, 0, 200, 0, 200), 5)
@@ -101,6 +133,20 @@ def test_summary_lists_the_hazard_that_forces_the_action_first() -> None:
         {"request": "fast", "action": 0, "state": {"v_ego": 0, "v_lim": 13.9}}
     )
     assert "Most urgent" not in environment_summary(standing)
+
+
+def test_summary_names_the_junction_where_the_car_gives_way() -> None:
+    rec = StateRecord.model_validate(
+        {"request": "fast", "action": -2, "state": {"v_ego": 8, "v_lim": 13.9, "d_yield": 20}}
+    )
+    # the line 20 m ahead is the only hazard; a comfortable stop from 8 m/s needs 8^2 / 4 = 16 m
+    assert environment_summary(rec) == (
+        "Ego speed 8.0 m/s (29 km/h); speed limit 13.9 m/s (50 km/h); urban area. "
+        "Junction in 20 m where we must give way: a car with priority is coming. "
+        "No vehicle ahead within 50 m. No traffic light within 50 m. "
+        "No pedestrian crossing within 50 m. "
+        "Most urgent: giving way at the junction 20 m ahead (a comfortable stop needs 16 m)."
+    )
 
 
 def test_history_summary_in_words() -> None:

@@ -15,6 +15,10 @@ The rules follow the paper's three principles for the decision prompt:
 3. with several reasons, keep the most safety-critical one: the hazard the car has to
    act on first (:mod:`explaindrive.language.explanation.hazards` ranks them by urgency).
 
+A yield line where the car must give way to a foe with priority (``d_yield``) is a stop
+line like a red light's: braking or standing for it is explained as giving way at the
+junction (:attr:`Factor.GIVE_WAY`), never as a vehicle ahead.
+
 Only objects within the cut-off (50 m) count.
 """
 
@@ -189,13 +193,16 @@ def lasting_standstill(record: StateRecord) -> bool:
 
 def holding_factors(s: RecordState) -> list[Factor]:
     """What holds the car back, nearest first: an occupied crossing, a red or yellow light,
-    a leader slower than :data:`~explaindrive.language.explanation.history.SLOW_MARGIN_MPS`
-    under the limit (a stopped one: a queue). ``s`` holds only objects within the cut-off."""
+    a yield line where it must give way, a leader slower than
+    :data:`~explaindrive.language.explanation.history.SLOW_MARGIN_MPS` under the limit (a
+    stopped one: a queue). ``s`` holds only objects within the cut-off."""
     found: list[tuple[float, Factor]] = []
     if s.d_cross is not None:
         found.append((s.d_cross, Factor.PEDESTRIAN))
     if s.tl_state in ("red", "yellow") and s.d_tl is not None:
         found.append((s.d_tl, Factor.TRAFFIC_LIGHT))
+    if s.d_yield is not None:
+        found.append((s.d_yield, Factor.GIVE_WAY))
     if s.d_lead is not None and s.v_ego - (s.dv or 0.0) <= s.v_lim - SLOW_MARGIN_MPS:
         found.append((s.d_lead, Factor.LEAD_VEHICLE))
     return [f for _, f in sorted(found, key=lambda x: x[0])]

@@ -6,6 +6,7 @@ import hashlib
 import re
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from typing import Any
 
 from explaindrive.language.explanation.decision import (
     Factor,
@@ -15,6 +16,11 @@ from explaindrive.language.explanation.decision import (
 from explaindrive.language.explanation.history import SLOW_MARGIN_MPS
 from explaindrive.language.explanation.summary import SUMMARY_CUTOFF_M, RecordState, StateRecord
 
+# Giving way to a pedestrian is the crossing's, not a junction's.
+_NOT_TO_PEDESTRIANS = (
+    r"(?!\s+to\s+(the\s+|a\s+|an\s+)?"
+    r"(pedestrians?|people|someone|somebody|person|child(ren)?|kids?|walkers?)\b)"
+)
 # Words that name each factor; used to check that a text is grounded in the state.
 _FACTOR_PATTERNS: dict[Factor, re.Pattern[str]] = {
     Factor.TRAFFIC_LIGHT: re.compile(r"\b(traffic[- ]lights?|lights?|signals?)\b", re.I),
@@ -27,6 +33,12 @@ _FACTOR_PATTERNS: dict[Factor, re.Pattern[str]] = {
     Factor.LEAD_VEHICLE: re.compile(
         r"\b(vehicles?|cars?|trucks?|bus|van|leader)\s+(ahead|in front)|\b(vehicle|car) "
         r"(just )?ahead|\bleading (vehicle|car)|\bheadway\b|\bthe (car|vehicle) in front",
+        re.I,
+    ),
+    Factor.GIVE_WAY: re.compile(
+        rf"\bgiv(e|es|ing|en) way\b{_NOT_TO_PEDESTRIANS}|\byield(s|ing|ed)?\b{_NOT_TO_PEDESTRIANS}"
+        r"|\bright[- ]of[- ]way\b|\bpriority (road|traffic)\b"
+        r"|\b(cars?|vehicles?|traffic|road) (with|that has|which has|has|have) (the )?priority\b",
         re.I,
     ),
     Factor.SPEED_LIMIT: re.compile(r"\bspeed[- ]limits?\b|\blimit\b", re.I),
@@ -83,19 +95,23 @@ def present_factors(state: RecordState) -> set[Factor]:
         found.add(Factor.PEDESTRIAN)
     if state.d_lead is not None:
         found.add(Factor.LEAD_VEHICLE)
+    if state.d_yield is not None:
+        found.add(Factor.GIVE_WAY)
     return found
 
 
 def cause_present(state: RecordState, factor: Factor | None) -> bool:
     """Whether ``factor`` still gives a reason in a (cut-off) state: a red or yellow light,
-    a pedestrian on the crossing, a vehicle ahead, the limit (always); ``None`` (a neutral
-    explanation): always."""
+    a pedestrian on the crossing, a vehicle ahead, a yield line in force, the limit
+    (always); ``None`` (a neutral explanation): always."""
     if factor is Factor.TRAFFIC_LIGHT:
         return state.tl_state in ("red", "yellow")
     if factor is Factor.PEDESTRIAN:
         return state.d_cross is not None
     if factor is Factor.LEAD_VEHICLE:
         return state.d_lead is not None
+    if factor is Factor.GIVE_WAY:
+        return state.d_yield is not None
     return True
 
 
@@ -180,6 +196,11 @@ _REASONS: dict[Factor, tuple[str, ...]] = {
         "because the car ahead is only {d_lead} m away",
         "to leave enough room to the vehicle in front, which is {d_lead} m ahead",
     ),
+    Factor.GIVE_WAY: (
+        "to give way at the junction {d_yield} m ahead: a car with priority is coming",
+        "because we must give way at the junction {d_yield} m ahead to a car with priority",
+        "as a car with priority is coming at the junction {d_yield} m ahead",
+    ),
     Factor.SPEED_LIMIT: (
         "to stay within the {v_lim_kmh} km/h speed limit here",
         "because the speed limit on this stretch is {v_lim_kmh} km/h",
@@ -208,6 +229,11 @@ _CLOSERS: dict[Factor, tuple[str, ...]] = {
         "Keeping this gap keeps the ride safe for everyone.",
         "I'll pick up the pace as soon as it is safe.",
     ),
+    Factor.GIVE_WAY: (
+        "We'll go as soon as it has passed.",
+        "It has the right of way, so we let it pass first.",
+        "We'll be on our way once the junction is clear.",
+    ),
     Factor.SPEED_LIMIT: (
         "We'll still get you there safely and on time.",
         "Driving faster here would not be safe or legal.",
@@ -217,8 +243,12 @@ _CLOSERS: dict[Factor, tuple[str, ...]] = {
 
 
 def _phrasing_key(record: StateRecord) -> str:
-    """What picks a record's phrasing: its step, not its history."""
-    return record.model_dump_json(exclude={"history"})
+    """What picks a record's phrasing: its step, not its history (a record without a yield
+    line is keyed as before ``d_yield`` existed, so its phrasing stays the same)."""
+    exclude: dict[str, Any] = {"history": True}
+    if record.state.d_yield is None:
+        exclude["state"] = {"d_yield"}
+    return record.model_dump_json(exclude=exclude)
 
 
 def _pick(options: tuple[str, ...], key: str) -> str:
@@ -299,6 +329,7 @@ def template_explanation(
         "d_tl": f"{s.d_tl:.0f}" if s.d_tl is not None else "",
         "tl_state": s.tl_state or "",
         "d_lead": f"{s.d_lead:.0f}" if s.d_lead is not None else "",
+        "d_yield": f"{s.d_yield:.0f}" if s.d_yield is not None else "",
         "v_lim_kmh": f"{round(s.v_lim * 3.6)}",
     }
     key = _phrasing_key(record)

@@ -4,8 +4,9 @@
 braking hard or gently, holding, waiting, accelerating) with the action and the speed.
 :func:`reply_problems` adds the checks a remote model's reply must pass before it reaches
 the passenger: it is an explanation (not a refusal, and it names the factor it explains),
-names no factor and no kind of hazard the state does not hold, gives the light's colour
-as it is, and gives distances and speeds within a tolerance of the state's.
+names no factor and no kind of hazard the state does not hold (a junction needs a light or
+a yield line in the state), gives the light's colour as it is, and gives distances and
+speeds within a tolerance of the state's.
 """
 
 from __future__ import annotations
@@ -69,6 +70,8 @@ _UNSUPPORTED = re.compile(
     r"|congestion|rush hour|sharp (bend|curve|turn)s?|bends?|curves?|hills?)\b",
     _I,
 )
+# A junction is in the state only as a light's or a yield line's.
+_JUNCTION = re.compile(r"\b(junctions?|intersections?|crossroads)\b", _I)
 _COLOURS = {"red": "red", "yellow": "yellow", "amber": "yellow", "green": "green"}
 _COLOUR_CLAIMS = (
     re.compile(r"\b(?P<colour>red|yellow|amber|green)\s+(traffic\s+)?(light|signal)s?\b", _I),
@@ -108,7 +111,11 @@ def wording_problems(text: str, record: StateRecord) -> list[str]:
 
 
 def _has_stop_target(s: RecordState) -> bool:
-    return s.d_cross is not None or (s.d_tl is not None and s.tl_state in ("red", "yellow"))
+    return (
+        s.d_cross is not None
+        or s.d_yield is not None
+        or (s.d_tl is not None and s.tl_state in ("red", "yellow"))
+    )
 
 
 def reply_problems(
@@ -137,6 +144,8 @@ def reply_problems(
     if grounding.absent:
         problems.append(f"names factors not in the state: {', '.join(grounding.absent)}")
     invented = sorted({m.group(0).lower() for m in _UNSUPPORTED.finditer(text)})
+    if s.d_tl is None and s.d_yield is None:
+        invented += sorted({m.group(0).lower() for m in _JUNCTION.finditer(text)})
     if invented:
         problems.append(f"names hazards the state does not hold: {', '.join(invented)}")
     problems += _colour_problems(text, s)
@@ -157,7 +166,7 @@ def _colour_problems(text: str, s: RecordState) -> list[str]:
 
 
 def _distance_problems(text: str, s: RecordState) -> list[str]:
-    known = [d for d in (s.d_lead, s.d_tl, s.d_cross) if d is not None]
+    known = [d for d in (s.d_lead, s.d_tl, s.d_cross, s.d_yield) if d is not None]
     out = []
     for m in _DISTANCE.finditer(text):
         said = float(m.group(1))

@@ -4,7 +4,8 @@ With several hazards present, the one that forces the action is the one the car 
 act on first. Each hazard gets a *slack*: the time left before the car must start
 braking for it at the comfortable deceleration (2 m/s^2), at its current speed.
 
-* a red or yellow light, or an occupied pedestrian crossing, at distance ``d``:
+* a red or yellow light, an occupied pedestrian crossing, or a yield line where the car
+  must give way to a foe with priority, at distance ``d``:
   ``(d - v^2 / (2 b)) / v`` — negative once the car is inside the stopping distance
   the stop line needs;
 * a leader closing at ``dv``: ``(gap - standstill gap - dv^2 / (2 b)) / dv`` — the
@@ -13,7 +14,7 @@ braking for it at the comfortable deceleration (2 m/s^2), at its current speed.
 * the speed limit: no slack to run out (it explains braking only when nothing else does).
 
 Speeds under 1 m/s count as 1 m/s, so a waiting car ranks what is nearest. Ties keep
-the order pedestrian, leader, light, limit.
+the order pedestrian, leader, light, yield line, limit.
 """
 
 from __future__ import annotations
@@ -42,10 +43,17 @@ class Factor(StrEnum):
     TRAFFIC_LIGHT = "traffic_light"
     PEDESTRIAN = "pedestrian"
     LEAD_VEHICLE = "lead_vehicle"
+    GIVE_WAY = "give_way"  # a junction where a foe with priority passes first
     SPEED_LIMIT = "speed_limit"
 
 
-_TIE_ORDER = (Factor.PEDESTRIAN, Factor.LEAD_VEHICLE, Factor.TRAFFIC_LIGHT, Factor.SPEED_LIMIT)
+_TIE_ORDER = (
+    Factor.PEDESTRIAN,
+    Factor.LEAD_VEHICLE,
+    Factor.TRAFFIC_LIGHT,
+    Factor.GIVE_WAY,
+    Factor.SPEED_LIMIT,
+)
 
 
 class _State(Protocol):
@@ -65,6 +73,8 @@ class _State(Protocol):
     def tl_state(self) -> str | None: ...
     @property
     def d_cross(self) -> float | None: ...
+    @property
+    def d_yield(self) -> float | None: ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,9 +151,9 @@ def leader_explains_firm_braking(s: _State, action: int) -> bool:
 def braking_hazards(s: _State) -> list[Hazard]:
     """Reasons to slow down present in ``s``, most urgent first.
 
-    A reason is an occupied crossing, a red or yellow light, a leader that is close
-    (:func:`leader_is_hazard`) or being at the speed limit; ``s`` is expected to hold only
-    objects within the cut-off.
+    A reason is an occupied crossing, a red or yellow light, a yield line in force, a
+    leader that is close (:func:`leader_is_hazard`) or being at the speed limit; ``s`` is
+    expected to hold only objects within the cut-off.
     """
     v = s.v_ego
     found: list[Hazard] = []
@@ -153,6 +163,8 @@ def braking_hazards(s: _State) -> list[Hazard]:
         found.append(Hazard(Factor.LEAD_VEHICLE, leader_slack_s(s), s.d_lead))
     if s.tl_state in ("red", "yellow") and s.d_tl is not None:
         found.append(Hazard(Factor.TRAFFIC_LIGHT, stop_line_slack_s(s.d_tl, v), s.d_tl))
+    if s.d_yield is not None:
+        found.append(Hazard(Factor.GIVE_WAY, stop_line_slack_s(s.d_yield, v), s.d_yield))
     if v >= s.v_lim - AT_LIMIT_MARGIN_MPS:
         found.append(Hazard(Factor.SPEED_LIMIT, math.inf, None))
     return sorted(found, key=lambda h: (h.slack_s, _TIE_ORDER.index(h.factor)))

@@ -4,10 +4,13 @@ A :class:`StateRecord` is the JSON shape the decision and explanation modules re
 
     {"request": "fast", "action": -2,
      "state": {"v_ego": 8.0, "v_lim": 13.9, "d_lead": 22.0, "dv": 1.5,
-               "d_tl": 35.0, "tl_state": "red", "d_cross": null},
+               "d_tl": 35.0, "tl_state": "red", "d_cross": null, "d_yield": null},
      "history": {"slow_s": 6.0, "stopped_s": 0.0, "drop_mps": 2.0}}
 
-``null`` means nothing within sensor range. ``history`` (optional) is what the passenger
+``null`` means nothing within sensor range. ``d_yield`` (optional) is the distance to the
+stop line of a junction where the car must give way now, to a foe with priority (a minor
+road, a priority junction, a permissive turn); the env holds the car there with a virtual
+leader, which the record does not show as a vehicle. ``history`` (optional) is what the passenger
 has felt up to the step (:mod:`~explaindrive.language.explanation.history`); a ride fills
 it, a record of a single step leaves it out. The summary and the decision ignore
 objects farther than a cut-off (50 m in the paper), see :meth:`StateRecord.nearby`.
@@ -69,6 +72,7 @@ class RecordState(BaseModel):
     d_tl: float | None = Field(default=None, ge=0.0)  # [m]
     tl_state: LightLabel | None = None
     d_cross: float | None = Field(default=None, ge=0.0)  # [m]
+    d_yield: float | None = Field(default=None, ge=0.0)  # [m] a yield line in force
 
     @model_validator(mode="after")
     def _consistent(self) -> RecordState:
@@ -83,6 +87,7 @@ class RecordState(BaseModel):
         lead = self.d_lead is not None and self.d_lead <= cutoff_m
         light = self.d_tl is not None and self.d_tl <= cutoff_m
         cross = self.d_cross is not None and self.d_cross <= cutoff_m
+        give_way = self.d_yield is not None and self.d_yield <= cutoff_m
         return RecordState(
             v_ego=self.v_ego,
             v_lim=self.v_lim,
@@ -91,6 +96,7 @@ class RecordState(BaseModel):
             d_tl=self.d_tl if light else None,
             tl_state=self.tl_state if light else None,
             d_cross=self.d_cross if cross else None,
+            d_yield=self.d_yield if give_way else None,
         )
 
 
@@ -114,16 +120,25 @@ class StateRecord(BaseModel):
         return self.state.within(cutoff_m)
 
     @classmethod
-    def from_observation(cls, obs: NDArray[np.floating], action_change_mps: int) -> StateRecord:
+    def from_observation(
+        cls,
+        obs: NDArray[np.floating],
+        action_change_mps: int,
+        *,
+        yield_gap_m: float | None = None,
+    ) -> StateRecord:
         """Build a record from the env's raw (not normalised) 8-dim observation.
 
         Distances at or beyond ``SENSOR_RANGE_M`` become ``None``. A leader that sits
-        on a red/yellow stop line or at an occupied crossing is the env's virtual leader
-        (paper, "virtual leader"), not a vehicle, and is dropped.
+        on a red/yellow stop line, at an occupied crossing or on the yield line is the
+        env's virtual leader (paper, "virtual leader"), not a vehicle, and is dropped.
 
         Args:
             obs: observation in ``explaindrive.env.state.STATE_NAMES`` order.
             action_change_mps: the speed change chosen for this step, -3..3 [m/s].
+            yield_gap_m: the gap to the yield line where the car must give way, perceived
+                with ``obs`` (the env's ``info["yield_gap_m"]``); ``None`` or the sensor
+                range: none.
 
         Raises:
             ValueError: on a wrong shape or an out-of-range value.
@@ -131,14 +146,13 @@ class StateRecord(BaseModel):
         s = DrivingState.from_array(np.asarray(obs, dtype=np.float64))
         light = s.d_tl < SENSOR_RANGE_M
         cross = s.d_cross < SENSOR_RANGE_M
-        lead = s.d_lead < SENSOR_RANGE_M
         colour = LightState(s.tls) if light else None
-        if lead:
-            on_light = colour in (LightState.RED, LightState.YELLOW) and (
-                abs(s.d_lead - s.d_tl) <= SEEN_VIRTUAL_LEADER_TOL_M
-            )
-            on_cross = cross and abs(s.d_lead - s.d_cross) <= SEEN_VIRTUAL_LEADER_TOL_M
-            lead = not (on_light or on_cross)
+        d_yield = yield_gap_m if yield_gap_m is not None and yield_gap_m < SENSOR_RANGE_M else None
+        stop_line = s.d_tl if colour in (LightState.RED, LightState.YELLOW) else None
+        lines = [d for d in (stop_line, s.d_cross if cross else None, d_yield) if d is not None]
+        lead = s.d_lead < SENSOR_RANGE_M and all(
+            abs(s.d_lead - line) > SEEN_VIRTUAL_LEADER_TOL_M for line in lines
+        )
         try:
             return cls(
                 request=Command(s.cmd).label,  # type: ignore[arg-type]
@@ -151,6 +165,7 @@ class StateRecord(BaseModel):
                     d_tl=round(s.d_tl, 1) if light else None,
                     tl_state=colour.label if colour is not None else None,  # type: ignore[arg-type]
                     d_cross=round(s.d_cross, 1) if cross else None,
+                    d_yield=round(d_yield, 1) if d_yield is not None else None,
                 ),
             )
         except ValidationError as exc:
@@ -212,7 +227,8 @@ def environment_summary(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M)
     Objects farther than ``cutoff_m`` are left out. The objects present are listed by
     urgency (:func:`~explaindrive.language.explanation.hazards.braking_hazards`: the one the car has
     to brake for first leads), and a last sentence names the most urgent reason to slow
-    down, with the figure that makes it urgent.
+    down, with the figure that makes it urgent. A light, a leader and a crossing that are
+    absent are said to be; a junction where the car must give way is named only when it is.
 
     Example:
         ``Ego speed 8.0 m/s (29 km/h); speed limit 13.9 m/s (50 km/h); urban area.
@@ -231,6 +247,7 @@ def environment_summary(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M)
         "lead_vehicle": _lead_sentence(s),
         "traffic_light": _light_sentence(s),
         "pedestrian": _crossing_sentence(s),
+        "give_way": _yield_sentence(s),
     }
     order = sorted(present, key=lambda f: urgent.index(f) if f in urgent else len(urgent))
     parts += [present[f] for f in order if present[f] is not None]  # type: ignore[misc]
@@ -240,7 +257,7 @@ def environment_summary(record: StateRecord, cutoff_m: float = SUMMARY_CUTOFF_M)
         "traffic_light": f"No traffic light within {limit}.",
         "pedestrian": f"No pedestrian crossing within {limit}.",
     }
-    parts += [absent[f] for f in order if present[f] is None]
+    parts += [absent[f] for f in order if present[f] is None and f in absent]
     if hazards:
         parts.append(f"Most urgent: {_urgency_phrase(s, hazards[0])}.")
     return " ".join(parts)
@@ -291,6 +308,12 @@ def _crossing_sentence(s: RecordState) -> str | None:
     return f"Pedestrian crossing the street {s.d_cross:.0f} m ahead."
 
 
+def _yield_sentence(s: RecordState) -> str | None:
+    if s.d_yield is None:
+        return None
+    return f"Junction in {s.d_yield:.0f} m where we must give way: a car with priority is coming."
+
+
 def _urgency_phrase(s: RecordState, hazard: Hazard) -> str:
     """What makes ``hazard`` urgent, in words ("the red traffic light 15 m ahead (...)")."""
     need = f"a comfortable stop needs {stopping_distance_m(s.v_ego):.0f} m"
@@ -298,6 +321,8 @@ def _urgency_phrase(s: RecordState, hazard: Hazard) -> str:
         return f"the {s.tl_state} traffic light {s.d_tl:.0f} m ahead ({need})"
     if hazard.factor is Factor.PEDESTRIAN:
         return f"the pedestrian crossing {s.d_cross:.0f} m ahead ({need})"
+    if hazard.factor is Factor.GIVE_WAY:
+        return f"giving way at the junction {s.d_yield:.0f} m ahead ({need})"
     if hazard.factor is Factor.LEAD_VEHICLE:
         ttc = ttc_s(s)
         timing = (
