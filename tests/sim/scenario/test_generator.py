@@ -114,10 +114,14 @@ def test_the_family_draws_priority_junctions_the_ego_yields_at(end: str, tmp_pat
     # the route's links, as netconvert built them: J1 and J2 signalised ("O" and "o", the
     # lights' own states before the programme), the zebra PX a minor link (its pedestrians
     # have priority; the crossing sensor handles it), Z2 major; Z1 minor where the side road
-    # has right of way, major on a road without it
+    # has right of way, major on a road without it; the high end also has K1 on J1's light
+    # ("O") and the taper T2 (major, one link into each of its two lanes)
     links = _route_links(files.net_file, files.route_edges)
-    z1 = "m" if drawn else "M"
-    assert links == [("J1", "O"), ("Z1", z1), ("PX", "m"), ("Z2", "M"), ("J2", "o")]
+    if drawn:
+        assert links == [("J1", "O"), ("K1", "O"), ("Z1", "m"), ("PX", "m"), ("Z2", "M"),
+                         ("T2", "M"), ("T2", "M"), ("J2", "o")]  # fmt: skip
+    else:
+        assert links == [("J1", "O"), ("Z1", "M"), ("PX", "m"), ("Z2", "M"), ("J2", "o")]
     # where the ego must yield to vehicles: at Z1, a junction without a light or crossing
     geometry = load_route_geometry(files.net_file, files.route_edges)
     plain = {j.node_id for j in geometry.junctions if not (j.signalized or j.crossing)}

@@ -39,6 +39,16 @@ def test_dotted_settings_change_one_value_each() -> None:
         # 40 s cycle, 30 s main green: the side road keeps 40 - 30 - 10 = 0 s
         (["j1.cycle_s=40", "j1.main_green_s=30"], "j1: the side road's green would be 0 s"),
         (["j2.offset_s=70"], "j2: offset_s must be below cycle_s (60)"),
+        # a 100 m turn lane in an 110 m block would start 10 m after Z2
+        (
+            ["zone_end_to_j2_m=110", "turn_lane_m=100"],
+            "turn_lane_m 100 m leaves under 20 m of its block zone_end_to_j2_m (110 m)",
+        ),
+        (
+            ["j1_to_zone_m=70", "joined_junction_m=60"],
+            "joined_junction_m 60 m leaves under 20 m of its block j1_to_zone_m (70 m)",
+        ),
+        (["turn_lane_m=30"], "turn_lane_m: Input should be greater than or equal to 40"),
     ],
 )
 def test_bad_settings_are_named(settings: list[str], message: str) -> None:

@@ -32,7 +32,8 @@ def nodes_xml(plan: layout.Layout = layout.PAPER_LAYOUT) -> str:
     """Plain node XML of the layout."""
     lines = ['<nodes version="1.20">']
     for n in plan.nodes:
-        lines.append(f"    <node {_attrs(id=n.id, x=n.x, y=n.y, type=n.type)}/>")
+        joined = {"tl": n.tl} if n.tl is not None else {}
+        lines.append(f"    <node {_attrs(id=n.id, x=n.x, y=n.y, type=n.type, **joined)}/>")
     lines.append("</nodes>")
     return "\n".join(lines) + "\n"
 
@@ -57,7 +58,7 @@ def edges_xml(plan: layout.Layout = layout.PAPER_LAYOUT) -> str:
                     id=eid,
                     **{"from": a},
                     to=b,
-                    numLanes=1,
+                    numLanes=road.forward_lanes if eid == road.forward else 1,
                     speed=f"{road.speed_mps:.4f}",
                     priority=_priority(road),
                     sidewalkWidth=layout.SIDEWALK_WIDTH_M,
@@ -78,9 +79,14 @@ def _priority(road: layout.Road) -> int:
 
 
 def connections_xml(plan: layout.Layout = layout.PAPER_LAYOUT) -> str:
-    """Plain connection XML holding the pedestrian crossings."""
+    """Plain connection XML: the lane connections the plan fixes (its lanes' arrows), then
+    the pedestrian crossings."""
     lines = ['<connections version="1.20">']
-    for node, edges in layout.CROSSINGS:
+    for c in plan.connections:
+        attrs = _attrs(**{"from": c.from_edge}, to=c.to_edge, fromLane=c.from_lane,
+                       toLane=c.to_lane)  # fmt: skip
+        lines.append(f"    <connection {attrs}/>")
+    for node, edges in plan.crossings:
         signalized = any(n.id == node and n.type == "traffic_light" for n in plan.nodes)
         attrs = _attrs(
             node=node,
@@ -156,11 +162,53 @@ def build_network(out_dir: Path, plan: layout.Layout = layout.PAPER_LAYOUT) -> P
     proc = subprocess.run(args, capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         raise RuntimeError(f"netconvert failed ({proc.returncode}):\n{proc.stderr}")
+    for tls_id in plan.joined_tls:
+        _merge_side_streams(net_file, tls_id)
     for tls_id, offset_s in plan.tls_offsets_s.items():
         _apply_offset(net_file, tls_id, offset_s)
     for tls_id, durations in plan.tls_phase_durations_s.items():
         _apply_durations(net_file, tls_id, durations)
     return net_file
+
+
+def _side_state(main: str, greens: list[str]) -> str:
+    """The side roads' green of a joined programme: every link red in the main green
+    ``main`` that one of the later ``greens`` lets go (``G`` before ``g``)."""
+    chars = []
+    for i, c in enumerate(main):
+        own = [g[i] for g in greens if g[i] in "Gg"]
+        chars.append("r" if c in "Gg" or not own else "G" if "G" in own else "g")
+    return "".join(chars)
+
+
+def _merge_side_streams(net_file: Path, tls_id: str) -> None:
+    """Merge the side-road greens of a joined programme into one phase.
+
+    netconvert gives a cluster of junctions on one light (``tl`` of the plain nodes) the
+    main road's green, then a green for each junction's side roads, each followed by a
+    yellow and an all-red. The family's lights have two streams (main road, side roads;
+    :meth:`~explaindrive.sim.scenario.params.SignalParams.durations`), so the side greens
+    become one: every side road of the cluster green at once, the main road red.
+
+    Raises:
+        RuntimeError: if the light is missing or its programme is not of that shape.
+    """
+    import re
+
+    text = net_file.read_text()
+    block = re.search(rf'<tlLogic id="{tls_id}".*?</tlLogic>', text, flags=re.S)
+    if block is None:
+        raise RuntimeError(f"traffic light {tls_id!r} not found in {net_file}")
+    states = re.findall(r'state="([^"]+)"', block.group(0))
+    if len(states) % 3 or len(states) < 6:
+        raise RuntimeError(f"traffic light {tls_id!r}: {len(states)} phases, not green, "
+                           "yellow and all-red per stream")  # fmt: skip
+    main, side = states[0], _side_state(states[0], states[3::3])
+    red = "r" * len(main)
+    phases = (main, states[1], red, side, re.sub("[Gg]", "y", side), red)
+    head = block.group(0).split("\n", 1)[0]
+    lines = [f'        <phase duration="1" state="{state}"/>' for state in phases]
+    net_file.write_text(text.replace(block.group(0), "\n".join([head, *lines, "    </tlLogic>"])))
 
 
 def _apply_durations(net_file: Path, tls_id: str, durations: tuple[int, ...]) -> None:

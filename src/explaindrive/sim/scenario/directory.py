@@ -42,7 +42,7 @@ def write_scenario_dir(
     """
     plan = make_layout(params)
     build_network(out, plan)
-    (out / DEMAND_FILE).write_text(routes_xml(1.0, plan))
+    (out / DEMAND_FILE).write_text(routes_xml(1.0, plan, plan.route_edges))
     doc: dict[str, Any] = {"name": name}
     if seed is not None:
         doc["seed"] = seed
@@ -82,9 +82,9 @@ def load_scenario_dir(directory: Path, cache_dir: Path) -> ScenarioFiles:
         ScenarioDirError: as :func:`read_params`.
     """
     name, params = read_params(directory)
-    return ScenarioFiles(
-        net_file=directory / NET_FILE, cache_dir=cache_dir, plan=make_layout(params), name=name
-    )
+    plan = make_layout(params)
+    return ScenarioFiles(net_file=directory / NET_FILE, cache_dir=cache_dir,
+                         route_edges=plan.route_edges, plan=plan, name=name)  # fmt: skip
 
 
 def cached_scenario_dir(params: ScenarioParams, name: str, cache_dir: Path,

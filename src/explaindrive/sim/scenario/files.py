@@ -169,7 +169,9 @@ class ScenarioFiles:
     @property
     def strategic_lane_changes(self) -> bool:
         """Whether SUMO changes the ego's lanes to follow its route (own networks, which
-        may have several lanes; the family's roads have one)."""
+        may have several lanes). The family's roads have one lane but for J2's turn lane,
+        which starts at a node whose one lane leads into both: SUMO takes the ego into the
+        one its route needs there, without a lane change."""
         return self.plan is None
 
     def routes_files(self, traffic_level: float) -> tuple[Path, ...]:

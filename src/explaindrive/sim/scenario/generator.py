@@ -13,7 +13,12 @@ from typing import Any, Literal
 import numpy as np
 
 from explaindrive.sim.scenario.limits import validate_seed
-from explaindrive.sim.scenario.params import SIGNAL_FIXED_S, ScenarioParams, min_yellow_s
+from explaindrive.sim.scenario.params import (
+    MIN_TAPER_GAP_M,
+    SIGNAL_FIXED_S,
+    ScenarioParams,
+    min_yellow_s,
+)
 
 TRAIN_SEED_START = 1_000_000
 """Scenario seeds of training draws start here; evaluation seeds lie below."""
@@ -47,7 +52,16 @@ RANGES: dict[str, tuple[float, float, float]] = {
     "j2_cross": (20, 120, 10),
     "priority_junction": (0, 1, 1),  # 0: no, 1: Z1 is a priority junction the ego yields at
     "z1_cross": (20, 120, 10),  # the main road yields to it: more jams it at high levels
+    # each of the three below is on at 2 (a third of the draws), off at 0 and 1
+    "turn_lanes": (0, 2, 1),  # J2's approach widens to a left-turn and a straight lane
+    "turn_lane_m": (60, 100, 10),  # and at most zone_end_to_j2_m - 20
+    "j2_left": (20, 120, 10),  # from the left-turn lane, only with turn_lanes
+    "left_turn": (0, 2, 1),  # the ego turns left at J2 on a permissive green
+    "joined_signals": (0, 2, 1),  # a junction K1 after J1 runs on J1's programme
+    "joined_junction_m": (20, 40, 5),
 }
+FEATURE_ON = 2
+"""The draw of ``turn_lanes``, ``left_turn`` and ``joined_signals`` that turns them on."""
 _SIGNAL_KEYS = ("cycle_s", "main_share", "yellow_s", "all_red_s")
 _DEMAND_KEYS = ("main_east", "main_west", "j1_cross", "j2_turn_south", "j2_turn_north",
                 "j2_cross")  # fmt: skip
@@ -75,7 +89,20 @@ def _params(pick: Any) -> ScenarioParams:
     # drawn last, so that every value drawn before keeps its draw of earlier versions
     data["priority_junction"] = bool(pick("priority_junction"))
     data["demand"]["z1_cross"] = float(pick("z1_cross"))
+    _junction_features(pick, data)
     return ScenarioParams.from_dict(data)
+
+
+def _junction_features(pick: Any, data: dict[str, Any]) -> None:
+    """Draw the turn lane, the ego's left turn and the joined signals into ``data``, after
+    every other value (each value is drawn whether its feature is on or not)."""
+    lanes_on, lane_m = pick("turn_lanes") == FEATURE_ON, float(pick("turn_lane_m"))
+    lane_m = min(lane_m, data["zone_end_to_j2_m"] - MIN_TAPER_GAP_M)
+    data["turn_lane_m"] = lane_m if lanes_on else None
+    data["demand"]["j2_left"] = float(pick("j2_left"))
+    data["left_turn"] = bool(pick("left_turn") == FEATURE_ON)
+    joined_on, joined_m = pick("joined_signals") == FEATURE_ON, float(pick("joined_junction_m"))
+    data["joined_junction_m"] = joined_m if joined_on else None
 
 
 def random_params(seed: int) -> ScenarioParams:

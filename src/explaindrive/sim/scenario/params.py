@@ -12,7 +12,10 @@ The road, west to east (block lengths in metres)::
 
 ``Z1``..``Z2`` is the low-limit zone around the zebra ``PX``. With ``priority_junction``,
 ``Z1`` is also an unsignalised priority junction where a side road with right of way
-crosses the main road: the ego must yield there.
+crosses the main road: the ego must yield there. With ``turn_lane_m``, the main road widens
+to two eastbound lanes at ``T2``, that far before ``J2``; with ``joined_junction_m``, a
+second signalised junction ``K1`` that far after ``J1`` runs on ``J1``'s programme; with
+``left_turn``, the ego leaves ``J2`` along its north arm instead of driving on to ``E0``.
 """
 
 from __future__ import annotations
@@ -31,6 +34,11 @@ Block = Annotated[float, Field(ge=60.0, le=600.0)]
 the next junction."""
 PedRate = Annotated[float, Field(ge=0.0, le=400.0)]
 """Pedestrians per hour in one direction (0: none)."""
+TurnLaneM = Annotated[float, Field(ge=40.0, le=150.0)]
+"""Length [m] of J2's left-turn lane, beside the straight lane up to the stop line."""
+JoinedGapM = Annotated[float, Field(ge=20.0, le=60.0)]
+"""From J1 to the junction K1 that shares its programme [m]."""
+MIN_TAPER_GAP_M = 20.0  # [m] from Z2 to the start T2 of the turn lane, from K1 to Z1
 
 YELLOW_BRAKE_MPS = 3.0  # [m/s per step] the braking a yellow must leave time for
 YELLOW_STOP_MARGIN_M = 2.0  # [m] short of the line a car braking that hard stands
@@ -112,6 +120,9 @@ class DemandParams(StrictModel):
     z1_cross: float = Field(default=120.0, ge=0.0, le=300.0)
     """Across the main road at Z1, each direction, when Z1 is a priority junction
     (``ScenarioParams.priority_junction``; no flow without it)."""
+    j2_left: float = Field(default=60.0, ge=0.0, le=300.0)
+    """Eastbound on the main road turning left (north) at J2 from its left-turn lane, when
+    J2 has one (``ScenarioParams.turn_lane_m``; no flow without it)."""
 
 
 class ScenarioParams(ConfigModel):
@@ -151,6 +162,32 @@ class ScenarioParams(ConfigModel):
     """Z1 is an unsignalised priority junction: a side road crosses the main road there
     with right of way over it, so the ego's link is a minor one (SUMO's state ``m``) and
     it must yield to the side road's traffic. The paper's road has none."""
+    turn_lane_m: TurnLaneM | None = None
+    """J2's eastbound approach has two lanes for its last ``turn_lane_m`` metres (from the
+    node T2): the left one turns left only, the right one goes straight or right (their
+    arrows are explicit connections); the single lane before T2 leads into both. At most
+    ``zone_end_to_j2_m`` minus 20 m. ``None``: one lane up to J2 (the paper's road)."""
+    left_turn: bool = False
+    """The ego's route turns left at J2 onto its north arm (``J2_J2N``) across the
+    westbound traffic, which has the same green: its link is a permissive green (SUMO's
+    state ``g``) and it must yield to the oncoming cars. ``False``: straight on to E0."""
+    joined_junction_m: JoinedGapM | None = None
+    """A second signalised junction K1, with a side road crossing the main road, this far
+    after J1 [m]; one programme (J1's) runs both, so the ego passes two stop lines of one
+    light. At most ``j1_to_zone_m`` minus 20 m. ``None``: no K1 (the paper's road)."""
+
+    @model_validator(mode="after")
+    def _check_junction_gaps(self) -> Self:
+        checks = ((self.turn_lane_m, self.zone_end_to_j2_m, "turn_lane_m", "zone_end_to_j2_m"),
+                  (self.joined_junction_m, self.j1_to_zone_m, "joined_junction_m",
+                   "j1_to_zone_m"))  # fmt: skip
+        for value, block, name, block_name in checks:
+            if value is not None and value > block - MIN_TAPER_GAP_M:
+                raise ValueError(
+                    f"{name} {value:g} m leaves under {MIN_TAPER_GAP_M:g} m of its block "
+                    f"{block_name} ({block:g} m)"
+                )
+        return self
 
     @model_validator(mode="after")
     def _check_signals(self) -> Self:
