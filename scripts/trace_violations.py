@@ -1,7 +1,7 @@
 """Print the steps that led to each violation of one episode of a bare network.
 
     python scripts/trace_violations.py src/explaindrive/agent/policies/fast.pt \
-        --seed 44 --traffic 0.75 [--obs-noise 3,0.9]
+        --seed 44 --traffic 0.75 [--obs-noise 3,0.9] [--scenario DIR]
 
 For every collision, red-light run or pedestrian-yield violation it prints the last
 ``--before`` steps: the time and the ego's route position, the observation, the
@@ -9,7 +9,10 @@ network's speed change, and the actions that the learning mask (the shipped reci
 and the run-time shield allow (one digit per action, -3 ... +3 m/s). With ``--obs-noise``
 the network sees a noisy observation, as ``explaindrive evaluate --obs-noise`` has it (a
 network trained on the speed estimate sees the estimate in place of the speed reading, and
-the row shows it); each step then shows the true state on a second line.
+the row shows it); each step then shows the true state on a second line. With
+``--scenario`` the episode runs on a scenario directory (``explaindrive scenario random
+--seed S --out DIR``). A collision also prints SUMO's record of it (who hit whom, on which
+lane).
 """
 
 from __future__ import annotations
@@ -35,6 +38,15 @@ def _bits(mask: object) -> str:
     return "".join("1" if allowed else "0" for allowed in mask)  # type: ignore[attr-defined]
 
 
+def _print_collisions(env: UrbanDriveEnv) -> None:
+    """SUMO's record of this step's collisions: collider, victim, their kind and lane."""
+    api = env.sumo
+    for c in api.simulation.getCollisions():
+        print(f"   SUMO: {c.collider} ({c.colliderType}, {c.colliderSpeed:.1f} m/s) hit "
+              f"{c.victim} ({c.victimType}, {c.victimSpeed:.1f} m/s) on {c.lane} at "
+              f"{c.pos:.1f} m: {c.type}")  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("policy", type=Path, help="a policy .pt file")
@@ -44,6 +56,7 @@ def main() -> None:
     parser.add_argument("--stop-schedule", default=None, help="e.g. 60-75,150-165 [s]")
     parser.add_argument("--before", type=int, default=6, help="steps shown before each event")
     parser.add_argument("--obs-noise", default="0,0", help="SD_M,SD_MPS on what the network sees")
+    parser.add_argument("--scenario", default=None, help="a scenario directory (default: paper)")
     args = parser.parse_args()
 
     noise = parse_noise(args.obs_noise)
@@ -60,6 +73,7 @@ def main() -> None:
             traffic_level=args.traffic,
             yellow_leader=agent.yellow_leader,
             obs_noise=(noise.sd_m, noise.sd_mps),
+            **({"scenario": args.scenario} if args.scenario else {}),
         )
     )
     obs, info = env.reset(
@@ -93,6 +107,8 @@ def main() -> None:
                 events += 1
                 print(f"-- {', '.join(happened)} at {info['time_s']:.0f} s")
                 print(*recent, sep="\n")
+                if info.get("collision"):
+                    _print_collisions(env)
     finally:
         env.close()
     print(f"{events} violation step(s) in {steps} steps")
