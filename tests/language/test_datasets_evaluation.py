@@ -14,6 +14,7 @@ from explaindrive.language.data import (
     DECISIONS_JSONL,
     FORMER_HELDOUT_CSVS,
     HELDOUT_CSV,
+    NEXT_HELDOUT_CSV,
     TEST_CSV,
     TRAIN_CSV,
     WRITTEN_CSV,
@@ -73,6 +74,15 @@ def test_the_test_split_and_no_line_learned_or_calibrated_on_near_it() -> None:
     ]
     seen += [r["text"] for r in read_lines(data_path(WRITTEN_CSV))]
     assert near_copies([t.text for t in heldout], seen) == set()
+
+
+def test_the_next_test_split_waits_unscored() -> None:
+    split = load_commands(data_path(NEXT_HELDOUT_CSV))
+    assert Counter(r.label for r in split) == {"fast": 98, "comfort": 102, "stop": 98, "none": 238}
+    negated = [r for r in split if r.kind == "negated_stop"]
+    assert len(negated) == 38 and "stop" not in {r.label for r in negated}
+    hedges = Counter(r.label for r in split if r.kind == "hedge")
+    assert hedges == {"fast": 16, "comfort": 16, "stop": 16}
 
 
 def test_near_copies_either_way_round() -> None:
