@@ -23,12 +23,7 @@ from explaindrive.language.explanation.explainer import (
 from explaindrive.language.explanation.grounding import reply_problems, wording_problems
 from explaindrive.language.explanation.hazards import braking_hazards
 from explaindrive.language.explanation.summary import StateRecord
-
-
-def rec(request: str, action: int, **state: Any) -> StateRecord:
-    base: dict[str, Any] = {"v_ego": 10.0, "v_lim": 13.9}
-    base.update(state)
-    return StateRecord.model_validate({"request": request, "action": action, "state": base})
+from tests.language.explanation.records import state_record as rec
 
 
 def test_fast_braking_for_red_light() -> None:

@@ -15,12 +15,11 @@ from explaindrive.language.explanation.explainer import (
 )
 from explaindrive.language.explanation.grounding import reply_problems
 from explaindrive.language.explanation.summary import StateRecord
+from tests.language.explanation.records import state_record
 
 
 def rec(request: str, action: int, **state: Any) -> StateRecord:
-    base: dict[str, Any] = {"v_ego": 9.0, "v_lim": 13.9}
-    base.update(state)
-    return StateRecord.model_validate({"request": request, "action": action, "state": base})
+    return state_record(request, action, **{"v_ego": 9.0, **state})
 
 
 def test_a_yield_line_is_a_factor_present_while_it_holds() -> None:
