@@ -24,14 +24,10 @@ LLM-1's negatives (split ``train``) and part of its calibration pool (``calibrat
 EVERYDAY_CHECK = "everyday_check.csv.gz"
 """The external check: chat messages of a public dialogue corpus no model is trained or
 selected on."""
-HELDOUT_CSV = "commands_heldout3.csv"
+HELDOUT_CSV = "commands_heldout4.csv"
 """The test split: written by an author who saw neither the data nor the models, committed
 before any model was run on it, scored once."""
-NEXT_HELDOUT_CSV = "commands_heldout4.csv"
-"""The next test split: written by an author who saw neither the data nor the models and
-committed before any model was run on it; no model has been scored on it yet. The next
-model's training drops the lines near it, and it is scored once, when that model ships."""
-FORMER_HELDOUT_CSVS = ("commands_heldout.csv", "commands_heldout2.csv")
+FORMER_HELDOUT_CSVS = ("commands_heldout.csv", "commands_heldout2.csv", "commands_heldout3.csv")
 """Development splits: the previous test splits (each scored once, its errors read since),
 trained on."""
 TEST_CSV = "commands_test.csv"

@@ -1,8 +1,9 @@
 """The lines LLM-1 learns from and is calibrated on, read from ``language/data``.
 
 * Requests (``commands_train.csv``): labelled passenger requests; its ``reserve`` split is
-  kept for calibration. The development splits ``commands_heldout.csv`` and
-  ``commands_heldout2.csv`` (the previous test splits) are trained on whole.
+  kept for calibration. The development splits ``commands_heldout.csv``,
+  ``commands_heldout2.csv`` and ``commands_heldout3.csv`` (the previous test splits) are
+  trained on whole.
 * Written lines (``commands_written.csv``): in-car chatter and phone talk that use pace and
   stopping words in other senses, questions about the car's behaviour (``why``), answers
   to a confirmation (``yes`` / ``no``), negated requests; one line in seven (by a hash of
@@ -13,7 +14,7 @@
 * The development splits ``commands_test.csv`` and ``commands_blind.csv`` are calibrated on,
   never trained on.
 
-The test split ``commands_heldout3.csv`` and the external check ``everyday_check.csv.gz``
+The test split ``commands_heldout4.csv`` and the external check ``everyday_check.csv.gz``
 are read by the evaluation only.
 """
 
