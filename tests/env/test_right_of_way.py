@@ -8,6 +8,7 @@ import dataclasses
 import math
 from collections.abc import Callable
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -15,18 +16,23 @@ import pytest
 from explaindrive.agent.shield import shield
 from explaindrive.env import state as S
 from explaindrive.env.right_of_way import (
+    CONFLICT_HALF_M,
     YIELD_JUDGE_GAP_S,
     YIELD_MARGIN_S,
     FoeMotion,
     JunctionFoe,
+    TurnGeometry,
     YieldSensor,
     arrival_time_s,
     clear_time_s,
+    crossing_offsets,
     enters_in_front,
     foe_window_s,
     junction_of,
     link_yields,
     must_yield,
+    turn_foe,
+    turn_geometry,
 )
 from explaindrive.env.urban_drive import UrbanDriveEnv
 from tests.conftest import NO_DEMAND, plain_net
@@ -51,6 +57,16 @@ EDGES = """<edges>
   <edge id="JS" from="J" to="S" priority="1" numLanes="1" speed="13.89"/>
 </edges>"""
 LINE_M = 292.8  # [m] netconvert's length of SJ: the yield line's route position
+# The same crossroads with two lanes a way and a light at J, held green for N-S
+# (:data:`NS_GREEN`; links 0-3 from NJ, 8-11 from SJ: right, straight twice, left): the left
+# turn from SJ_1 to JW is a permissive green ``g`` across NJ -> JS, and waits at an internal
+# junction 5.01 m past the stop line. SUMO's ``getJunctionFoes`` lists no oncoming foe there.
+NS_GREEN = "GGGgrrrrGGGgrrrr"
+TWO_LANE_EDGES = EDGES.replace('numLanes="1"', 'numLanes="2"')
+TWO_LANE_LINE_M = 289.6  # [m] netconvert's length of SJ with two lanes a way
+LIGHT_NODES = NODES.replace(
+    'id="J" x="0" y="0" type="priority"', 'id="J" x="0" y="0" type="traffic_light"'
+)
 
 
 @pytest.fixture(scope="module")
@@ -60,6 +76,14 @@ def crossroads(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     folder = tmp_path_factory.mktemp("crossroads")
     (folder / "empty.rou.xml").write_text(NO_DEMAND)
     return plain_net(folder, "crossroads", NODES, EDGES), folder / "empty.rou.xml"
+
+
+@pytest.fixture(scope="module")
+def left_turn(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The signalised crossroads above and a demand with no car."""
+    folder = tmp_path_factory.mktemp("left_turn")
+    (folder / "empty.rou.xml").write_text(NO_DEMAND)
+    return plain_net(folder, "left_turn", LIGHT_NODES, TWO_LANE_EDGES), folder / "empty.rou.xml"
 
 
 def test_the_ego_clears_accelerating_hardest_up_to_the_limit() -> None:
@@ -194,25 +218,36 @@ def test_entering_the_conflict_in_front_of_a_foe_with_priority_is_a_violation() 
     assert not enters_in_front(no_priority, at_12, 4.0, 5.0)
 
 
-def _drive(env: UrbanDriveEnv, foe_at_step: int, steps: int = 70) -> list[dict[str, float]]:
+def _drive(
+    env: UrbanDriveEnv,
+    foe_at_step: int,
+    steps: int = 70,
+    foe_route: tuple[str, str] = ("WJ", "JE"),
+    light: str = "",
+    foe_lane: str = "first",
+) -> list[dict[str, float]]:
     """Drive the ego by the shield, asking for the fastest change (a SUMO baseline ego drives
-    itself); a foe enters the priority road at its start, at 13.89 m/s, after
-    ``foe_at_step`` steps. One row a step; the last one's ``t`` is the arrival time [s]."""
+    itself); a foe enters ``foe_route`` (the priority road) at its start, on ``foe_lane``, at
+    13.89 m/s, after ``foe_at_step`` steps; J's light, if it has one, is held at the state
+    ``light``. One row a step; the last one's ``t`` is the arrival time [s]."""
     obs, info = env.reset(seed=0)
     api = env.sumo
-    api.route.add("major", ["WJ", "JE"])
+    api.route.add("major", list(foe_route))
+    if light:
+        api.trafficlight.setRedYellowGreenState("J", light)
     rows = []
     for i in range(steps):
         if i == foe_at_step:
-            api.vehicle.add("foe", "major", departPos="0", departSpeed="13.89")
+            api.vehicle.add("foe", "major", departPos="0", departSpeed="13.89",
+                            departLane=foe_lane)  # fmt: skip
         seen = env._episode().seen
         assert seen is not None
         foe_road = api.vehicle.getRoadID("foe") if "foe" in api.vehicle.getIDList() else ""
         rows.append({"pos": env.route_pos_m, "v": float(obs[S.V_EGO]),
                      "lead": float(obs[S.D_LEAD]), "dv": float(obs[S.DV]),
                      "yield": seen.yields.leader_gap_m, "info_yield": info["yield_gap_m"],
-                     "foe_on_je": foe_road == "JE",
-                     "foe_gone": foe_road in ("JE", ""),
+                     "foe_out": foe_road == foe_route[1],
+                     "foe_gone": foe_road in (foe_route[1], ""),
                      "yield_violation": False})  # fmt: skip
         decision = shield(obs, np.arange(7, dtype=np.float64))  # the fastest safe change
         obs, _r, terminated, truncated, info = env.step(decision.action)
@@ -243,7 +278,7 @@ def test_a_yield_line_holds_the_ego_while_a_foe_with_priority_approaches(
         assert r["dv"] == pytest.approx(r["v"], abs=1e-6)
     # the ego's front crosses the line only once the foe has left the junction
     first_past = next(r for r in rows if r["pos"] > LINE_M)
-    assert first_past["foe_on_je"]
+    assert first_past["foe_out"]
     assert min(LINE_M - r["pos"] for r in rows if r["pos"] <= LINE_M) > 0.0
     # once the foe has passed, the line is no leader
     assert all(r["yield"] == S.SENSOR_RANGE_M for r in rows if r["foe_gone"])
@@ -302,8 +337,129 @@ def test_the_shielded_ego_yields_as_sumo_krauss_does(
         env = make_env(net_file=net, route=("SJ", "JN"), demand_file=demand, warmup_s=0,
                        max_steps=70, ego_model=model)  # fmt: skip
         rows = _drive(env, foe_at_step=3)
-        assert next(r for r in rows if r["pos"] > LINE_M)["foe_on_je"]  # after the foe
+        assert next(r for r in rows if r["pos"] > LINE_M)["foe_out"]  # after the foe
         times[model] = rows[-1]["t"]
     # measured: both arrive 52 s after entering (48 s with the rule off: the ego crosses
     # before the foe, which brakes for it)
     assert times["agent"] == pytest.approx(times["krauss"], abs=2.0)
+
+
+def test_where_two_lanes_cross_along_each() -> None:
+    assert crossing_offsets([(0, 0), (0, 10)], [(-5, 4), (5, 4)]) == (4.0, 5.0)
+    # a left turn: 4 m ahead, then 10 m to the left; a way down across it 3 m to the left
+    turn = [(0.0, 0.0), (0.0, 4.0), (-10.0, 4.0)]
+    assert crossing_offsets(turn, [(-3, 10), (-3, -10)]) == (4.0 + 3.0, 6.0)
+    # a way merging into the turn's end meets it there: 14 m along the turn, 9.22 m along it
+    merge = crossing_offsets(turn, [(-3, 10), (-10, 4)])
+    assert merge == (pytest.approx(14.0), pytest.approx(math.hypot(7.0, 6.0)))
+    assert crossing_offsets(turn, [(5, 0), (5, 10)]) is None
+
+
+def test_a_foe_at_the_internal_junction_of_a_turn_meets_it_where_their_lanes_cross() -> None:
+    # the lanes cross 7 m along the ego's way from its line and 6 m along the foe's via
+    # lane; the ego 20 m before its line, the foe 30 m before its via lane: the area is
+    # 2.5 m either side of 27 m and of 36 m
+    assert CONFLICT_HALF_M == 2.5
+    foe = turn_foe("foe", ":J_1_0", 6.0, 7.0, 30.0, 20.0, ":J_14_0")
+    assert foe == JunctionFoe("foe", 24.5, 33.5, 29.5, 38.5, ":J_14_0", ":J_1_0", True, False,
+                              True)  # fmt: skip
+    assert junction_of(foe.ego_lane) == "J"
+
+
+_LINKS = {":J_8_0": [("JW_0", False, True, False, ":J_14_0", "m", "l", 10.0)],
+          ":J_7_0": [("JN_0", True, True, False, "", "M", "s", 0.0)],
+          "NJ_0": [("JW_0", True, True, False, ":J_0_0", "G", "r", 9.22),
+                   ("JS_0", True, True, False, ":J_1_0", "G", "s", 20.0),
+                   ("JE_0", False, True, False, ":J_2_0", "g", "l", 4.0)]}  # fmt: skip
+_SHAPES = {":J_8_0": [(0.0, 0.0), (0.0, 4.0)], ":J_14_0": [(0.0, 4.0), (-10.0, 4.0)],
+           ":J_0_0": [(-3.0, 10.0), (-10.0, 4.0)],
+           ":J_1_0": [(-3.0, 10.0), (-3.0, -10.0)]}  # fmt: skip
+# ``lane`` of a network with the left turn of the test above: its foes are NJ_0's links
+# (two of them) and a walking area; NJ's right turn and straight cross the lane after the
+# internal junction, its left turn does not
+_LANE_API = SimpleNamespace(
+    getLinks=lambda lane: _LINKS.get(lane, []),
+    getLength=lambda lane: 4.0,
+    getShape=lambda lane: _SHAPES[lane],
+    getFoes=lambda lane, to: ("NJ_0", "NJ_0", ":J_w0_0"),
+    getInternalFoes=lambda lane: (
+        (":J_0_0", ":J_1_0", ":J_7_0") if lane == ":J_14_0" else (":J_1_0",)
+    ),
+)
+
+
+def test_the_foes_of_a_turn_are_the_links_with_priority_crossing_its_way() -> None:
+    api = SimpleNamespace(lane=_LANE_API)
+    assert turn_geometry(api, ":J_8_0") == TurnGeometry(
+        4.0, ":J_14_0",
+        (("NJ_0", ":J_0_0", pytest.approx(math.hypot(7.0, 6.0)), pytest.approx(14.0)),
+         ("NJ_0", ":J_1_0", 6.0, 7.0)),
+    )  # fmt: skip
+    assert turn_geometry(api, ":J_7_0") is None  # straight on: no internal junction
+
+
+def test_the_judge_lets_a_turning_ego_accelerate_out_of_the_conflict() -> None:
+    at_10 = FoeMotion(10.0, 2.6, 13.89, 5.0)
+    # the ego 1 m before a 5 m area at 2 m/s, 5 m long: at that speed its back leaves after
+    # 11 / 2 = 5.5 s; accelerating at 2.6 m/s^2 from its wait at the internal junction,
+    # 2 t + 1.3 t^2 = 11 gives 2.24 s. A foe at 10 m/s 40 m away arrives at 4 s.
+    crossing = JunctionFoe("foe", 1.0, 40.0, 6.0, 45.0, ":J_14_0", ":J_1_0", True, False)
+    assert enters_in_front(crossing, at_10, 2.0, 5.0)  # 4 < 5.5 + 1
+    assert not enters_in_front(crossing._replace(turning=True), at_10, 2.0, 5.0)  # 4 > 3.24
+    # 30 m away it arrives at 3 s < 2.24 + 1
+    near = crossing._replace(foe_dist_m=30.0, foe_exit_m=35.0, turning=True)
+    assert enters_in_front(near, at_10, 2.0, 5.0)
+
+
+@pytest.mark.slow
+def test_a_permissive_left_turn_waits_at_the_line_for_an_oncoming_car(
+    make_env: Callable[..., UrbanDriveEnv], left_turn: tuple[Path, Path]
+) -> None:
+    net, demand = left_turn
+    env = make_env(net_file=net, route=("SJ", "JW"), demand_file=demand, warmup_s=0,
+                   max_steps=70)  # fmt: skip
+    # the ego, turning left on the permissive green, reaches the line after about 23 s; the
+    # oncoming foe (NJ -> JS), entering after 3 s, reaches J after about 24 s
+    rows = _drive(env, foe_at_step=3, foe_route=("NJ", "JS"), light=NS_GREEN, foe_lane="1")
+    held = [r for r in rows if r["yield"] < S.SENSOR_RANGE_M]
+    assert held, "the yield line was never a leader"
+    for r in held:  # the virtual leader stands at the stop line, not inside the junction
+        assert r["yield"] == pytest.approx(TWO_LANE_LINE_M - r["pos"], abs=1e-6)
+        assert r["lead"] == pytest.approx(TWO_LANE_LINE_M - r["pos"], abs=1e-3)
+    # the ego's front crosses the line only once the foe is out of the junction
+    assert next(r for r in rows if r["pos"] > TWO_LANE_LINE_M)["foe_out"]
+    assert all(r["yield"] == S.SENSOR_RANGE_M for r in rows if r["foe_gone"])
+    assert not any(r["yield_violation"] for r in rows)  # and _drive checks: no collision
+
+
+@pytest.mark.slow
+def test_turning_left_in_front_of_an_oncoming_car_is_a_yield_violation(
+    make_env: Callable[..., UrbanDriveEnv], left_turn: tuple[Path, Path]
+) -> None:
+    net, demand = left_turn
+    env = make_env(net_file=net, route=("SJ", "JW"), demand_file=demand, warmup_s=0,
+                   max_steps=40)  # fmt: skip
+    obs, _ = env.reset(seed=0)
+    api = env.sumo
+    api.route.add("major", ["NJ", "JS"])
+    api.trafficlight.setRedYellowGreenState("J", NS_GREEN)
+    flagged = []
+    for i in range(40):
+        if i == 3:
+            api.vehicle.add("foe", "major", departPos="0", departSpeed="13.89", departLane="1")
+        before = env.route_pos_m
+        foe_to_j = api.lane.getLength("NJ_1") - api.vehicle.getLanePosition("foe") if i > 3 else 0
+        change = int(np.clip(13 - round(float(obs[S.V_EGO])), -3, 3))  # no shield
+        obs, _r, terminated, truncated, info = env.step(change + 3)
+        if info["yield_violation"]:
+            flagged.append((before, env.route_pos_m, foe_to_j))
+        if terminated or truncated:
+            break
+    # 13 m a step from 4 steps on. The ego's way (its 5.01 m via lane, then the lane after its
+    # internal junction) crosses the centre line of NJ_1's straight via lane 9.91 m past the
+    # stop line at 289.6 m, 11.68 m along that via lane; the area is 2.5 m either side. The
+    # step from 295.1 m to 308.1 m enters it 289.6 + 9.91 - 2.5 - 295.1 = 1.91 m in, at 0.15 s;
+    # driving on at 2.6 m/s^2 from 13 m/s, the ego's back leaves it 5 + 5 + 1.91 = 11.91 m on,
+    # at 0.85 s (13 t + 1.3 t^2 = 11.91); the foe, 12.1 m before its via lane at 13.89 m/s,
+    # arrives (12.1 + 11.68 - 2.5) / 13.89 = 1.53 s after the step's start, within 1 s
+    assert flagged == [(pytest.approx(295.1), pytest.approx(308.1), pytest.approx(12.1, abs=0.1))]

@@ -33,8 +33,23 @@ before a standing car. A line the ego can no longer stop before even braking har
 (:func:`~explaindrive.env.actions.can_stop_before`) is not a leader: the ego is committed,
 and braking would only leave it in the conflict (the yellow light's dilemma zone, in
 :mod:`explaindrive.env.lights`). A line behind the ego's front (it is inside the junction)
-is none either: SUMO's drivers wait inside a junction for a left turn at its internal
-junction, which the ego does not model.
+is none either.
+
+A turn across oncoming traffic (a permissive ``g`` at a light, or any yielding link whose via
+lane leads to an internal junction) is where SUMO resolves the conflict at the internal
+junction, where its own drivers wait inside the junction: the approach link's foes, and so
+``getJunctionFoes``, leave the oncoming lanes out. The sensor reads them from the network
+(:func:`turn_geometry`, once per via lane): ``lane.getFoes`` of the link out of the ego's via
+lane gives the incoming lanes with right of way there, and of their links those whose via lane
+is among the internal foes of the ego's way (``lane.getInternalFoes``) and whose centre line
+crosses the ego's (:func:`crossing_offsets`) are its foes. The vehicles on such an incoming
+lane bound for that via lane (a foe at red or red-yellow, or at yellow and able to stop, is
+left out: :func:`stops_at_signal`), and those on the via lane, are foes with priority
+(:func:`turn_foe`), their conflict area :data:`CONFLICT_HALF_M` either side of where the
+centre lines cross, along each way. The rule then holds the ego at the stop line, not inside
+the junction, and the judge reads the area (for this one it lets the ego, which drives on
+from a wait, accelerate out of it at 2.6 m/s², SUMO's default). Vehicles on the lanes
+before a foe's incoming lane are not seen.
 
 The judge of yield violations (:func:`enters_in_front`) reads the conflict area itself, as
 traffic-safety practice does with the post-encroachment time: the ego breaks the right of
@@ -58,8 +73,9 @@ is read once the ego has passed it.
 
 from __future__ import annotations
 
+import itertools
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -83,6 +99,9 @@ MAX_ACCEL_MPS = max(SPEED_CHANGES_MPS)  # [m/s per step] the ego's hardest accel
 FOE_ACCEL_MPS2 = 2.6  # [m/s^2] a foe's acceleration when SUMO gives none (its default)
 YIELD_STATES = frozenset("gmsw=oZ")  # the ego's link states that yield to foes with priority
 NO_SIGNAL_STATES = frozenset("rRu")  # a foe at red or red-yellow does not enter
+CONFLICT_HALF_M = 2.5
+"""[m] A turn's conflict area with a foe reaches this far either side of where their centre
+lines cross: half a 3.2 m lane and half a 1.8 m car, and a little."""
 _CLEAR_STEPS_MAX = 60  # steps after which a clearing time is taken as never
 
 
@@ -99,6 +118,7 @@ class JunctionFoe(NamedTuple):
     foe_lane: str  # the foe's internal lane through the conflict
     ego_responds: bool  # the ego's link must yield to the foe's (junction logic)
     foe_responds: bool  # the foe's link must yield to the ego's
+    turning: bool = False  # a foe at the internal junction of the ego's turn (turn_foe)
 
 
 @dataclass(frozen=True, slots=True)
@@ -235,8 +255,114 @@ def enters_in_front(
     ego_speed_mps = travelled_m / STEP_LENGTH_S
     ego_enters = foe.ego_dist_m / ego_speed_mps
     ego_leaves = (foe.ego_exit_m + ego_length_m) / ego_speed_mps
+    if foe.turning:  # it drives on from its wait at the internal junction: accelerating
+        ego_leaves = arrival_time_s(
+            foe.ego_exit_m + ego_length_m, ego_speed_mps, FOE_ACCEL_MPS2, math.inf
+        )
     foe_arrives, foe_leaves = foe_window_s(foe, motion)
     return foe_leaves > ego_enters and foe_arrives < ego_leaves + YIELD_JUDGE_GAP_S
+
+
+def stops_at_signal(api: Any, foe_id: str, state: str, to_line_m: float) -> bool:
+    """Whether a foe ``to_line_m`` before a link in ``state`` will not enter: the link is
+    red or red-yellow (:data:`NO_SIGNAL_STATES`), or yellow and the foe can still stop
+    before it braking at its own deceleration, as SUMO's drivers then do."""
+    if state in NO_SIGNAL_STATES:
+        return True
+    if state not in "yY":
+        return False
+    speed = float(api.vehicle.getSpeed(foe_id))
+    return speed * speed / (2.0 * float(api.vehicle.getDecel(foe_id))) <= to_line_m
+
+
+class TurnGeometry(NamedTuple):
+    """A link whose via lane leads to an internal junction, where a turning car waits for
+    the foes SUMO resolves there (module docstring).
+
+    Attributes:
+        via_m: [m] the length of the ego's via lane, from the stop line to the internal
+            junction.
+        inner_lane: the internal lane after the internal junction.
+        foes: ``(incoming lane, its via lane crossing the ego's way, where their centre
+            lines cross [m] along that via lane and along the ego's way from its stop line)``
+            of each link with right of way over the ego's at the internal junction.
+    """
+
+    via_m: float
+    inner_lane: str
+    foes: tuple[tuple[str, str, float, float], ...]
+
+
+def crossing_offsets(
+    ours: Sequence[tuple[float, float]], theirs: Sequence[tuple[float, float]]
+) -> tuple[float, float] | None:
+    """[m] Where two polylines first cross (or touch), as the distance along each from its
+    start (the first crossing along ``ours``; ``None``: they do not meet)."""
+    along_ours = 0.0
+    for (ax, ay), (bx, by) in itertools.pairwise(ours):
+        along_theirs, seg = 0.0, math.hypot(bx - ax, by - ay)
+        for (cx, cy), (dx, dy) in itertools.pairwise(theirs):
+            other = math.hypot(dx - cx, dy - cy)
+            det = (bx - ax) * (dy - cy) - (by - ay) * (dx - cx)
+            if det != 0.0:
+                t = ((cx - ax) * (dy - cy) - (cy - ay) * (dx - cx)) / det
+                u = ((cx - ax) * (by - ay) - (cy - ay) * (bx - ax)) / det
+                if -1e-9 <= t <= 1.0 + 1e-9 and -1e-9 <= u <= 1.0 + 1e-9:
+                    return along_ours + t * seg, along_theirs + u * other
+            along_theirs += other
+        along_ours += seg
+    return None
+
+
+def turn_geometry(api: Any, via: str) -> TurnGeometry | None:
+    """The :class:`TurnGeometry` of the ego's via lane ``via``, read from the network
+    (``None``: its link leads to no internal junction)."""
+    onward = [link for link in api.lane.getLinks(via) if str(link[4]).startswith(":")]
+    if not onward:
+        return None
+    next_lane, inner = str(onward[0][0]), str(onward[0][4])
+    via_m = float(api.lane.getLength(via))
+    path = [*api.lane.getShape(via), *api.lane.getShape(inner)]
+    crossing = set(api.lane.getInternalFoes(via)) | set(api.lane.getInternalFoes(inner))
+    foes = []
+    for incoming in sorted(set(api.lane.getFoes(via, next_lane))):
+        if incoming.startswith(":"):  # a walking area: pedestrians are not judged here
+            continue
+        for link in api.lane.getLinks(incoming):
+            if link[4] in crossing:
+                met = crossing_offsets(path, api.lane.getShape(link[4]))
+                if met is not None:
+                    foes.append((incoming, str(link[4]), met[1], met[0]))
+    return TurnGeometry(via_m, inner, tuple(foes))
+
+
+def turn_foe(
+    foe_id: str,
+    foe_via: str,
+    foe_at_m: float,
+    ego_at_m: float,
+    foe_to_entry_m: float,
+    ego_to_line_m: float,
+    inner_lane: str,
+) -> JunctionFoe:
+    """A foe at a turn's internal junction as a :class:`JunctionFoe`: the conflict area is
+    :data:`CONFLICT_HALF_M` either side of where the two centre lines cross.
+
+    Args:
+        foe_id: the foe.
+        foe_via: its via lane through the junction.
+        foe_at_m: [m] where the centre lines cross, along the foe's via lane.
+        ego_at_m: [m] where they cross, along the ego's way from its stop line.
+        foe_to_entry_m: [m] from the foe's front to the start of its via lane (negative
+            inside).
+        ego_to_line_m: [m] from the ego's front to its stop line (negative past it).
+        inner_lane: the ego's internal lane after its internal junction.
+    """
+    ego_at, foe_at = ego_to_line_m + ego_at_m, foe_to_entry_m + foe_at_m
+    return JunctionFoe(
+        foe_id, ego_at - CONFLICT_HALF_M, foe_at - CONFLICT_HALF_M, ego_at + CONFLICT_HALF_M,
+        foe_at + CONFLICT_HALF_M, inner_lane, foe_via, True, False, True,
+    )  # fmt: skip
 
 
 class Conflict(NamedTuple):
@@ -289,6 +415,8 @@ class YieldSensor:
         self.unregulated = unregulated
         self._types: dict[str, tuple[float, float]] = {}  # foe id -> (accel, length)
         self._link_states: dict[str, str] = {}  # junction -> the ego's link, last read ahead
+        self._vias: dict[str, str] = {}  # junction -> the ego's via lane, last read ahead
+        self._turns: dict[str, TurnGeometry | None] = {}  # via lane -> its turn, if one
 
     def line_gap(self, junction: str, pos_m: float) -> float | None:
         """[m] from route position ``pos_m`` to the stop line of the next passage through
@@ -345,10 +473,64 @@ class YieldSensor:
             if gap >= S.SENSOR_RANGE_M or junction in self.unregulated:
                 break
             self._link_states[junction] = state
+            self._vias[junction] = str(link[4])
             if link_yields(state):
                 states[junction] = state
                 reach = gap + float(link[7]) + 1.0  # [m] its whole length, and a metre
         return states, reach
+
+    def line_at(self, junction: str, pos_m: float) -> float | None:
+        """[m] The route position of the stop line of the passage through ``junction`` that
+        the ego (its front at route position ``pos_m``) is before or in (``None``: none)."""
+        for node, line_m, end_m in self.junctions:
+            if node == junction and pos_m < end_m:
+                return line_m
+        return None
+
+    def turn(self, api: Any, via: str) -> TurnGeometry | None:
+        """The :class:`TurnGeometry` of the ego's via lane ``via`` (read once, then kept)."""
+        if via not in self._turns:
+            self._turns[via] = turn_geometry(api, via)
+        return self._turns[via]
+
+    def turn_foes(self, api: Any, junction: str, pos_m: float) -> list[JunctionFoe]:
+        """The foes with priority at the internal junction of the ego's turn through
+        ``junction`` (module docstring): the vehicles on a foe's incoming lane bound for its
+        crossing via lane, and those on that via lane."""
+        via = self._vias.get(junction, "")
+        turn = self.turn(api, via) if via else None
+        line_m = self.line_at(junction, pos_m)
+        if turn is None or line_m is None:
+            return []
+        foes: list[JunctionFoe] = []
+        for incoming, foe_via, foe_at, ego_at in turn.foes:
+            to_entry = float(api.lane.getLength(incoming))
+            near = []
+            for vid in api.lane.getLastStepVehicleIDs(incoming):
+                links = api.vehicle.getNextLinks(vid)
+                dist = to_entry - float(api.vehicle.getLanePosition(vid))
+                if (
+                    links
+                    and links[0][4] == foe_via
+                    and not stops_at_signal(api, vid, links[0][5], dist)
+                ):
+                    near.append((vid, dist))
+            near += [(vid, -float(api.vehicle.getLanePosition(vid)))
+                     for vid in api.lane.getLastStepVehicleIDs(foe_via)]  # fmt: skip
+            foes += [turn_foe(vid, foe_via, foe_at, ego_at, dist, line_m - pos_m,
+                              turn.inner_lane) for vid, dist in near]  # fmt: skip
+        return foes
+
+    def foes(
+        self, api: Any, states: dict[str, str], reach: float, pos_m: float
+    ) -> list[JunctionFoe]:
+        """The foes at the yielding links ``states`` (:meth:`horizon`): SUMO's
+        (``vehicle.getJunctionFoes`` up to ``reach``) and those of a turn's internal
+        junction (:meth:`turn_foes`)."""
+        found = [JunctionFoe(*raw) for raw in api.vehicle.getJunctionFoes(EGO_ID, reach)]
+        for junction in states:
+            found.extend(self.turn_foes(api, junction, pos_m))
+        return found
 
     def __call__(self, api: Any, pos_m: float, speed_mps: float, limit_mps: float) -> YieldReading:
         """The yield lines ahead of the ego's front (at route position ``pos_m``) where it
@@ -360,8 +542,7 @@ class YieldSensor:
             return NO_YIELD
         entry_reach_m = (speed_mps + MAX_ACCEL_MPS) * STEP_LENGTH_S  # the most a step covers
         leader, conflicts = S.SENSOR_RANGE_M, []
-        for raw in api.vehicle.getJunctionFoes(EGO_ID, reach):
-            foe = JunctionFoe(*raw)
+        for foe in self.foes(api, states, reach, pos_m):
             junction = junction_of(foe.ego_lane)
             state = states.get(junction)
             if state is None or not foe.ego_responds:
