@@ -412,7 +412,7 @@ def test_the_judge_lets_a_turning_ego_accelerate_out_of_the_conflict() -> None:
 
 
 @pytest.mark.slow
-def test_a_permissive_left_turn_waits_at_the_line_for_an_oncoming_car(
+def test_a_permissive_left_turn_waits_inside_the_junction_for_an_oncoming_car(
     make_env: Callable[..., UrbanDriveEnv], left_turn: tuple[Path, Path]
 ) -> None:
     net, demand = left_turn
@@ -423,11 +423,13 @@ def test_a_permissive_left_turn_waits_at_the_line_for_an_oncoming_car(
     rows = _drive(env, foe_at_step=3, foe_route=("NJ", "JS"), light=NS_GREEN, foe_lane="1")
     held = [r for r in rows if r["yield"] < S.SENSOR_RANGE_M]
     assert held, "the yield line was never a leader"
-    for r in held:  # the virtual leader stands at the stop line, not inside the junction
-        assert r["yield"] == pytest.approx(TWO_LANE_LINE_M - r["pos"], abs=1e-6)
-        assert r["lead"] == pytest.approx(TWO_LANE_LINE_M - r["pos"], abs=1e-3)
-    # the ego's front crosses the line only once the foe is out of the junction
-    assert next(r for r in rows if r["pos"] > TWO_LANE_LINE_M)["foe_out"]
+    # the virtual leader stands where SUMO's drivers wait, at the internal junction 5.01 m
+    # past the stop line (the conflict area starts later: 9.91 - 2.5 = 7.41 m past it)
+    for r in held:
+        assert r["yield"] == pytest.approx(TWO_LANE_LINE_M + 5.01 - r["pos"], abs=0.01)
+        assert r["lead"] == pytest.approx(TWO_LANE_LINE_M + 5.01 - r["pos"], abs=0.01)
+    # the ego's front passes the internal junction only once the foe is out of the junction
+    assert next(r for r in rows if r["pos"] > TWO_LANE_LINE_M + 5.01)["foe_out"]
     assert all(r["yield"] == S.SENSOR_RANGE_M for r in rows if r["foe_gone"])
     assert not any(r["yield_violation"] for r in rows)  # and _drive checks: no collision
 

@@ -61,7 +61,8 @@ def test_training_file_splits() -> None:
 
 def test_the_test_split_and_no_line_learned_or_calibrated_on_near_it() -> None:
     heldout = load_commands(data_path(HELDOUT_CSV))
-    assert Counter(r.label for r in heldout) == {"fast": 98, "comfort": 102, "stop": 98, "none": 238}
+    labels = Counter(r.label for r in heldout)
+    assert labels == {"fast": 98, "comfort": 102, "stop": 98, "none": 238}
     negated = [r for r in heldout if r.kind == "negated_stop"]
     assert len(negated) == 38 and "stop" not in {r.label for r in negated}
     hedges = Counter(r.label for r in heldout if r.kind == "hedge")

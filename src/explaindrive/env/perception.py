@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from explaindrive.commands import Command
 from explaindrive.env import state as S
+from explaindrive.env.lane_split import SplitSensor
 from explaindrive.env.lights import AmberDecision
 from explaindrive.env.right_of_way import NO_YIELD, YieldReading, YieldSensor
 from explaindrive.sim.crossing_lanes import CrossingLane, pedestrian_in_lane
@@ -123,14 +124,22 @@ class LeaderSensor:
     def __init__(self, ego_min_gap_m: float, lengths: dict[str, float]) -> None:
         self.ego_min_gap_m = ego_min_gap_m
         self._lengths = lengths
+        self.splits = SplitSensor(lengths)
 
     def __call__(self, api: Any, ego: Any) -> Leader | None:
-        """The real leader from the ego's subscription results ``ego``."""
+        """The real leader from the ego's subscription results ``ego``: SUMO's, or a vehicle
+        in the other branch of a lane split that is still in the ego's way
+        (:mod:`explaindrive.env.lane_split`), whichever is nearer."""
         lead = ego.get(tc.VAR_LEADER)
-        gap = float(lead[1]) + self.ego_min_gap_m if lead and lead[0] else S.SENSOR_RANGE_M
+        gap, lid = S.SENSOR_RANGE_M, ""
+        if lead and lead[0]:
+            gap, lid = float(lead[1]) + self.ego_min_gap_m, lead[0]
+        lane = ego.get(tc.VAR_LANE_ID)
+        split = self.splits(api, lane, float(ego[tc.VAR_LANEPOSITION])) if lane else None
+        if split is not None and split[0] < gap:
+            gap, lid = split
         if gap >= S.SENSOR_RANGE_M:
             return None
-        lid = lead[0]
         length = self._lengths.get(lid)
         if length is None:
             length = self._lengths[lid] = float(api.vehicle.getLength(lid))

@@ -46,10 +46,13 @@ crosses the ego's (:func:`crossing_offsets`) are its foes. The vehicles on such 
 lane bound for that via lane (a foe at red or red-yellow, or at yellow and able to stop, is
 left out: :func:`stops_at_signal`), and those on the via lane, are foes with priority
 (:func:`turn_foe`), their conflict area :data:`CONFLICT_HALF_M` either side of where the
-centre lines cross, along each way. The rule then holds the ego at the stop line, not inside
-the junction, and the judge reads the area (for this one it lets the ego, which drives on
-from a wait, accelerate out of it at 2.6 m/s², SUMO's default). Vehicles on the lanes
-before a foe's incoming lane are not seen.
+centre lines cross, along each way. The rule then holds the ego where SUMO's own drivers
+wait, inside the junction: at the internal junction, or short of the conflict area if that
+comes first (:meth:`YieldSensor.wait_gap`). So when the phase ends and the oncoming stream
+stops at its red, the ego clears the junction, as they do; held at the stop line it could
+wait through every phase of a saturated stream. The judge reads the area (for this one it
+lets the ego, which drives on from a wait, accelerate out of it at 2.6 m/s², SUMO's
+default). Vehicles on the lanes before a foe's incoming lane are not seen.
 
 The judge of yield violations (:func:`enters_in_front`) reads the conflict area itself, as
 traffic-safety practice does with the post-encroachment time: the ego breaks the right of
@@ -493,6 +496,20 @@ class YieldSensor:
             self._turns[via] = turn_geometry(api, via)
         return self._turns[via]
 
+    def wait_gap(self, junction: str, foe: JunctionFoe, pos_m: float) -> float | None:
+        """[m] From the ego's front (at route position ``pos_m``) to where it waits for
+        ``foe``: the stop line of ``junction``, or for a foe of its turn (``foe.turning``) the
+        turn's internal junction or the start of their conflict area, whichever comes first
+        (``None``: nothing ahead)."""
+        if not foe.turning:
+            return self.line_gap(junction, pos_m)
+        turn = self._turns.get(self._vias.get(junction, ""))
+        line_m = self.line_at(junction, pos_m)
+        if turn is None or line_m is None:
+            return None
+        gap = min(foe.ego_dist_m, line_m + turn.via_m - pos_m)
+        return gap if gap >= 0.0 else None
+
     def turn_foes(self, api: Any, junction: str, pos_m: float) -> list[JunctionFoe]:
         """The foes with priority at the internal junction of the ego's turn through
         ``junction`` (module docstring): the vehicles on a foe's incoming lane bound for its
@@ -551,7 +568,7 @@ class YieldSensor:
             if 0.0 < foe.ego_dist_m <= entry_reach_m:
                 motion = self.foe_motion(api, foe)
                 conflicts.append(Conflict(foe, motion))
-            gap = self.line_gap(junction, pos_m)
+            gap = self.wait_gap(junction, foe, pos_m)
             if gap is None or gap >= leader or not can_stop_before(speed_mps, gap):
                 continue
             motion = motion or self.foe_motion(api, foe)

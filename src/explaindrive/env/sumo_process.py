@@ -29,7 +29,7 @@ from explaindrive.sim.scenario.files import (
 
 log = logging.getLogger(__name__)
 
-EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER)
+EGO_VARS = (tc.VAR_SPEED, tc.VAR_DISTANCE, tc.VAR_LEADER, tc.VAR_LANE_ID, tc.VAR_LANEPOSITION)
 SIM_VARS = (tc.VAR_ARRIVED_VEHICLES_IDS, tc.VAR_COLLIDING_VEHICLES_IDS)
 ENTRY_CLEAR_AFTER_S = 10  # [s] the entry stretch is cleared after every such wait for a gap
 ENTRY_CLEAR_M = 30.0  # [m] length of that stretch
