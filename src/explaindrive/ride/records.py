@@ -101,7 +101,7 @@ class ModuleCounts:
 class RideCounts:
     """Counters for the ride summary (``models``: per language module)."""
 
-    requests: int = 0
+    lines: int = 0
     answers: int = 0
     questions: int = 0
     understood: int = 0
@@ -120,8 +120,14 @@ class RideCounts:
         default_factory=lambda: {m: ModuleCounts() for m in MODULES}
     )
 
+    @property
+    def requests(self) -> int:
+        """The passenger's lines that were neither an answer to a question nor a "why?"."""
+        return self.lines - self.answers - self.questions
+
     def to_json(self) -> dict[str, Any]:
-        """JSON-ready dict."""
+        """JSON-ready dict (with ``requests``)."""
         out: dict[str, Any] = {k: v for k, v in self.__dict__.items() if k != "models"}
+        out["requests"] = self.requests
         out["models"] = {m: c.__dict__.copy() for m, c in self.models.items()}
         return out

@@ -90,7 +90,7 @@ class PassengerRequests:
             raise TypeError(f"confirm must be True, False or None, got {confirm!r}")
         self._requests += 1
         req = PassengerRequest(self._requests, self._clock(), line, confirm)
-        self.counts.requests += 1
+        self.counts.lines += 1
         text: str | None = None
         audio: str | None = None
         match line:
@@ -151,7 +151,7 @@ class PassengerRequests:
             self._hear_answer(answer)
             return
         if result.reading == WHY_READING and self.on_question is not None:
-            self.counts.requests -= 1  # a question, not a request: the command stays
+            # a question, not a request: the command stays
             self.counts.questions += 1
             self.on_question(req.id)
             return
@@ -220,7 +220,6 @@ class PassengerRequests:
         """A line read as yes or no answers the pending question; heard while a request is
         still being interpreted (several workers: the answer may be read first), it waits
         for that request's question."""
-        self.counts.requests -= 1  # the line was an answer, not a request
         self.counts.answers += 1
         if self.pending_confirmation is not None:
             self.answer(yes)
