@@ -110,11 +110,13 @@ class Percept:
 
 
 class LeaderSensor:
-    """The vehicle ahead in the ego's lane within sensor range (bumper-to-bumper gap).
+    """The vehicle ahead in the ego's way within sensor range (bumper-to-bumper gap).
 
     SUMO's leader of the ego (``VAR_LEADER``, read after each step), so a vehicle that
     changes into the ego's lane ahead is the leader from the step it is in the lane, and
-    one beside the ego is none (tests/env/test_cut_in.py).
+    one beside the ego is none (tests/env/test_cut_in.py); or, if nearer, a vehicle in the
+    other branch of a lane split whose back is still in the ego's way
+    (:class:`~explaindrive.env.lane_split.SplitSensor`, tests/env/test_lane_split.py).
 
     Args:
         ego_min_gap_m: the ego's minGap, which SUMO subtracts from leader gaps [m].
