@@ -16,13 +16,13 @@ import pytest
 
 from explaindrive.env import state as S
 from explaindrive.env.urban_drive import UrbanDriveEnv
+from explaindrive.evaluation.generalisation import NETWORKS, built_network
 from explaindrive.sim.route import RouteJunction
 from explaindrive.sim.sumo_home import sumo_binary
 from tests.conftest import GRID_WITH_LIGHTS, plain_net
 
 pytestmark = pytest.mark.slow  # SUMO episodes
 
-OSM_TOWN = Path(__file__).parent / "data" / "town.osm.xml"
 
 # A road from W to E crosses a dual carriageway: a northbound one-way road at J1 and a
 # southbound one at J2, 40 m apart. One programme, "C", runs both junctions (a joined
@@ -83,14 +83,12 @@ def random_joined(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def osm_town(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A small town written as OpenStreetMap for the tests (``data/town.osm.xml``): Main
+    """A small town written as OpenStreetMap (``sim/scenario/data/town.osm.xml``): Main
     Street (primary, 50 km/h) crosses Signal Lane at a traffic signal and Give Way Road
-    (residential, 30 km/h) at a priority junction, built by netconvert as any OSM extract."""
-    out = tmp_path_factory.mktemp("osm") / "town.net.xml"
-    subprocess.run([sumo_binary("netconvert"), "--osm-files", str(OSM_TOWN), "--no-turnarounds",
-                    "true", "--geometry.remove", "true", "-o", str(out)],
-                   check=True, capture_output=True)  # fmt: skip
-    return out
+    (residential, 30 km/h) at a priority junction, built by netconvert as any OSM extract
+    (as the generalisation table builds it)."""
+    town = next(n for n in NETWORKS if n.name == "town")
+    return built_network(town, tmp_path_factory.mktemp("osm"))
 
 
 def joined_routes(net_file: Path, n: int) -> list[tuple[str, str]]:

@@ -1,4 +1,4 @@
-"""The generalisation table's scenarios: held-out draws and netgenerate networks."""
+"""The generalisation table's scenarios: held-out draws and the networks SUMO's tools build."""
 
 from __future__ import annotations
 
@@ -12,20 +12,29 @@ from explaindrive.sim.route import load_route_geometry
 
 def test_the_groups_and_their_routes(tmp_path: Path) -> None:
     groups = gen.scenario_groups(tmp_path)
-    assert list(groups) == ["held-out generated", "netgenerate grid", "netgenerate spider"]
+    assert list(groups) == ["held-out generated", "netgenerate grid", "netgenerate spider",
+                            "netgenerate random", "netconvert town"]  # fmt: skip
     assert [c.name for c in groups["held-out generated"]][::19] == ["random-100", "random-119"]
-    lights = {}
+    lights, unsignalised = {}, {}
     for network in gen.NETWORKS:
-        net = gen.netgen_network(network, tmp_path)
+        net = gen.built_network(network, tmp_path)
         geometry = load_route_geometry(net, route_edges(net, *network.route))
         lights[network.name] = [light.tls_id for light in geometry.lights]
-    assert lights == {"grid": ["B1", "C1", "D1"], "spider": ["C1", "B1", "B3", "C3"]}
+        unsignalised[network.name] = sum(not j.signalized for j in geometry.junctions)
+    assert lights == {"grid": ["B1", "C1", "D1"], "spider": ["C1", "B1", "B3", "C3"],
+                      "random": ["1383", "685", "173", "134", "4", "103"],
+                      "town": []}  # fmt: skip
+    # the real-junction networks: 7 of the random route's 13 junctions have no light, and
+    # the town's one is the priority junction where Give Way Road meets Main Street
+    assert unsignalised == {"grid": 0, "spider": 1, "random": 7, "town": 1}
     plans = gen.plan_generalisation({"krauss": parse_policy("krauss")}, groups)
     # 20 scenarios x seeds 0, 1 x level 1.0; one scenario each for the networks
     assert {k: len(p.episodes) for k, p in plans.items()} == {
         ("krauss", "held-out generated"): 40,
         ("krauss", "netgenerate grid"): 2,
         ("krauss", "netgenerate spider"): 2,
+        ("krauss", "netgenerate random"): 2,
+        ("krauss", "netconvert town"): 2,
     }
 
 

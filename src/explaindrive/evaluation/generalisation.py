@@ -1,11 +1,14 @@
 """The generalisation table of the results document: the policies off the road they were
 trained on.
 
-Three groups of scenarios: the 20 generated scenarios held out from training
-(``random:100-119``), and two networks SUMO's ``netgenerate`` makes (a grid and a spider web,
-every junction signalised), each with a route through at least three lights and trips
-generated over the network. One row per policy; per group the mean speed and the safety
-counts over every episode.
+Five groups of scenarios: the 20 generated scenarios held out from training
+(``random:100-119``); two networks SUMO's ``netgenerate`` makes with every junction signalised
+(a grid and a spider web), each with a route through at least three lights; and two with
+real junctions: a ``netgenerate`` random network with priority junctions (random road
+priorities, lights where netconvert's heuristic puts them) and a small town netconvert builds
+from OpenStreetMap (``sim/scenario/data/town.osm.xml``), where the ego turns from a minor road
+onto the main street. Each has trips generated over the network. One row per policy; per
+group the mean speed and the safety counts over every episode.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 import subprocess
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 from explaindrive.evaluation.aggregate import summarize
@@ -33,40 +37,64 @@ DEFAULT_SEEDS: tuple[int, ...] = (0, 1)
 DEFAULT_LEVELS: tuple[float, ...] = (1.0,)
 
 
+TOWN_OSM = "town.osm.xml"
+"""A small town written as OpenStreetMap (``sim/scenario/data``): Main Street (primary,
+50 km/h) crosses Signal Lane at a traffic signal and Give Way Road (residential, 30 km/h) at a
+priority junction."""
+
+
 @dataclass(frozen=True, slots=True)
-class NetgenNetwork:
-    """A network made by ``netgenerate`` and the ego's route through it."""
+class BuiltNetwork:
+    """A network SUMO's tools build and the ego's route through it: ``netgenerate`` with
+    ``options``, or, with ``osm``, ``netconvert`` from that shipped OpenStreetMap file."""
 
     name: str
     options: tuple[str, ...]
     route: tuple[str, str]
+    osm: str = ""
 
 
-NETWORKS: tuple[NetgenNetwork, ...] = (
+NETWORKS: tuple[BuiltNetwork, ...] = (
     # 5 x 5 blocks of 200 m; A1B1 -> D1E1 passes the lights B1, C1, D1
-    NetgenNetwork("grid", ("--grid", "--grid.number", "5", "--grid.length", "200",
-                           "--default-junction-type", "traffic_light"), ("A1B1", "D1E1")),
+    BuiltNetwork("grid", ("--grid", "--grid.number", "5", "--grid.length", "200",
+                          "--default-junction-type", "traffic_light"), ("A1B1", "D1E1")),
     # 5 arms, 3 rings 150 m apart; D1C1 -> C3D3 crosses the centre: lights C1, B1, B3, C3
-    NetgenNetwork("spider", ("--spider", "--spider.arm-number", "5", "--spider.circle-number",
-                             "3", "--spider.space-radius", "150", "--default-junction-type",
-                             "traffic_light"), ("D1C1", "C3D3")),
+    BuiltNetwork("spider", ("--spider", "--spider.arm-number", "5", "--spider.circle-number",
+                            "3", "--spider.space-radius", "150", "--default-junction-type",
+                            "traffic_light"), ("D1C1", "C3D3")),
+    # 80 random nodes, two lanes a way, random road priorities, lights where the sum of the
+    # speeds in exceeds 90 km/h (36 priority junctions, 22 lights); 1039 -> -11 is 1,537 m
+    # over 13 junctions, 7 of them priority junctions
+    BuiltNetwork("random", ("--rand", "--rand.iterations", "80", "--rand.min-distance", "60",
+                            "--rand.max-distance", "200", "--rand.random-priority", "true",
+                            "--default.lanenumber", "2", "--default-junction-type", "priority",
+                            "--tls.guess", "true", "--tls.guess.threshold", "90",
+                            "--tls.join", "true", "--tls.join-dist", "40"), ("1039", "-11")),
+    # from Give Way Road onto Main Street: a minor link at a priority junction
+    BuiltNetwork("town", ("--geometry.remove", "true"), ("30#0", "10#2"), osm=TOWN_OSM),
 )  # fmt: skip
+REAL_JUNCTIONS = ("random", "town")
+"""The networks with priority junctions and minor links."""
 
 
-def netgen_network(network: NetgenNetwork, cache_dir: Path) -> Path:
-    """The network file, made with ``netgenerate`` on first use and cached.
+def built_network(network: BuiltNetwork, cache_dir: Path) -> Path:
+    """The network file, built on first use and cached.
 
     Raises:
-        RuntimeError: if netgenerate fails.
+        RuntimeError: if netgenerate or netconvert fails.
     """
     out = cache_dir / "netgenerate" / f"{network.name}.net.xml"
     if not out.is_file():
         out.parent.mkdir(parents=True, exist_ok=True)
-        args = [sumo_binary("netgenerate"), *network.options, "--no-turnarounds", "true",
-                "--seed", "7", "-o", str(out)]  # fmt: skip
+        if network.osm:
+            osm = resources.files("explaindrive.sim.scenario") / "data" / network.osm
+            tool = [sumo_binary("netconvert"), "--osm-files", str(osm)]
+        else:
+            tool = [sumo_binary("netgenerate"), "--seed", "7"]
+        args = [*tool, *network.options, "--no-turnarounds", "true", "-o", str(out)]
         proc = subprocess.run(args, capture_output=True, text=True, check=False)
         if proc.returncode != 0:
-            raise RuntimeError(f"netgenerate failed for {network.name}: {proc.stderr[-500:]}")
+            raise RuntimeError(f"{tool[0]} failed for {network.name}: {proc.stderr[-500:]}")
     return out
 
 
@@ -76,8 +104,8 @@ def scenario_groups(cache_dir: Path) -> dict[str, list[ScenarioCase]]:
         "held-out generated": list(parse_scenarios(HELD_OUT, cache_dir))
     }
     for network in NETWORKS:
-        net = netgen_network(network, cache_dir)
-        groups[f"netgenerate {network.name}"] = [
+        net = built_network(network, cache_dir)
+        groups[f"{'netconvert' if network.osm else 'netgenerate'} {network.name}"] = [
             network_case(network.name, {"net_file": net, "route": network.route})
         ]
     return groups
@@ -146,8 +174,10 @@ def generalisation_section(by_run: Mapping[tuple[str, str], Sequence[EpisodeReco
     intro = (
         "\n## Generalisation\n\n"
         f"Roads no policy was trained on: the 20 generated scenarios held out from training "
-        f"(`{HELD_OUT}`) and two `netgenerate` networks (a grid and a spider web, every "
-        f"junction signalised) with trips generated over them; seeds "
+        f"(`{HELD_OUT}`), two `netgenerate` networks with every junction signalised (a grid "
+        "and a spider web), and two with priority junctions and minor links (a `netgenerate` "
+        "random network with random road priorities, and a town netconvert builds from "
+        "OpenStreetMap), with trips generated over them; seeds "
         f"{', '.join(map(str, seeds))}, traffic level(s) {', '.join(f'{x:g}' for x in levels)}."
         "\n\n"
     )
