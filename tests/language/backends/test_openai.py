@@ -72,7 +72,8 @@ def test_http_500_and_timeout_fall_back(
     openai_server: ScriptedOpenAI, interpreter: EmbeddedIntentInterpreter
 ) -> None:
     openai_server.script = [("http", 500)]
-    r = OpenAIIntentInterpreter(client(openai_server), interpreter).interpret("I feel sick")
+    line = "Please drive more gently."  # embedded: comfort, not a STOP (which is not asked)
+    r = OpenAIIntentInterpreter(client(openai_server), interpreter).interpret(line)
     assert r.fallback and r.intent is Command.COMFORT and "500" in (r.error or "")
     openai_server.script = [("slow", 1.0, "[EXPLAIN]")]
     d = OpenAIDecider(client(openai_server, timeout_s=0.3), RuleDecider()).decide(RED)

