@@ -1,7 +1,8 @@
-"""Print the steps that led to each violation of one episode of a bare network.
+"""Print the steps that led to each violation of one episode of a network, bare (or with
+``--shield``, through the run-time shield).
 
     python scripts/trace_violations.py src/explaindrive/agent/policies/fast.pt \
-        --seed 44 --traffic 0.75 [--obs-noise 3,0.9] [--scenario DIR]
+        --seed 44 --traffic 0.75 [--obs-noise 3,0.9] [--scenario DIR] [--shield]
 
 For every collision, red-light run or pedestrian-yield violation it prints the last
 ``--before`` steps: the time and the ego's route position, the observation, the
@@ -57,12 +58,13 @@ def main() -> None:
     parser.add_argument("--before", type=int, default=6, help="steps shown before each event")
     parser.add_argument("--obs-noise", default="0,0", help="SD_M,SD_MPS on what the network sees")
     parser.add_argument("--scenario", default=None, help="a scenario directory (default: paper)")
+    parser.add_argument("--shield", action="store_true", help="act through the run-time shield")
     args = parser.parse_args()
 
     noise = parse_noise(args.obs_noise)
     agent = QPolicy.load(args.policy)
     command = Command.parse(args.command or agent.card.get("mode", "fast"))
-    driver = MergedController(agent, agent, command, use_shield=False)
+    driver = MergedController(agent, agent, command, use_shield=args.shield)
     schedule = (
         stops_to_schedule(command.label, parse_stop_schedule(args.stop_schedule))
         if args.stop_schedule
