@@ -21,7 +21,6 @@ from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 from explaindrive.env import state as S
-from explaindrive.sim.scenario.files import EGO_ID
 
 SIDE_BY_SIDE_M = 2.0
 """[m] Two centre lines closer than this leave no room for two cars side by side (1.8 m wide
@@ -59,6 +58,14 @@ def shared_stretch_m(
     return along
 
 
+def vehicle_length(api: Any, lengths: dict[str, float], vid: str) -> float:
+    """[m] Vehicle ``vid``'s length, read from SUMO once and kept in ``lengths``."""
+    length = lengths.get(vid)
+    if length is None:
+        length = lengths[vid] = float(api.vehicle.getLength(vid))
+    return length
+
+
 class Branch(NamedTuple):
     """The other branches of a split beside the ego's internal lane.
 
@@ -84,6 +91,7 @@ class SplitSensor:
     def __init__(self, lengths: dict[str, float]) -> None:
         self._lengths = lengths
         self._branches: dict[str, Branch] = {}  # the ego's internal lane -> its branch
+        self._lane_lengths: dict[str, float] = {}
 
     def branch(self, api: Any, approach: str, via: str) -> Branch:
         """The :class:`Branch` of the ego's internal lane ``via`` out of ``approach`` (read
@@ -105,7 +113,9 @@ class SplitSensor:
             kept = self._branches[via] = Branch(approach, tuple(siblings))
         return kept
 
-    def __call__(self, api: Any, lane: str, lane_pos_m: float) -> tuple[float, str] | None:
+    def __call__(
+        self, api: Any, lane: str, lane_pos_m: float, next_links: Sequence[Any]
+    ) -> tuple[float, str] | None:
         """The nearest vehicle in another branch that is still in the ego's way: the gap from
         the ego's front to its back [m] and its id (``None``: none within sensor range).
 
@@ -113,17 +123,23 @@ class SplitSensor:
             api: the running simulation.
             lane: the ego's lane.
             lane_pos_m: the ego's front along it.
+            next_links: the ego's links ahead this step (``vehicle.getNextLinks``).
         """
         if lane in self._branches:  # on its own internal lane of a split
             branch, to_start = self._branches[lane], -lane_pos_m
         elif lane.startswith(":"):
             return None
         else:
-            to_start = float(api.lane.getLength(lane)) - lane_pos_m
-            links = api.vehicle.getNextLinks(EGO_ID) if to_start < S.SENSOR_RANGE_M else ()
-            if not links or not str(links[0][4]).startswith(":"):
+            length = self._lane_lengths.get(lane)
+            if length is None:
+                length = self._lane_lengths[lane] = float(api.lane.getLength(lane))
+            to_start = length - lane_pos_m
+            if to_start >= S.SENSOR_RANGE_M or not next_links:
                 return None
-            branch = self.branch(api, lane, str(links[0][4]))
+            via = str(next_links[0][4])
+            if not via.startswith(":"):
+                return None
+            branch = self.branch(api, lane, via)
         nearest: tuple[float, str] | None = None
         for sibling, length_m, onward, shared_m in branch.siblings:
             for vid, back in self._backs(api, branch, sibling, length_m, onward):
@@ -143,9 +159,7 @@ class SplitSensor:
             for vid in api.lane.getLastStepVehicleIDs(on) if on else ():
                 if on == onward and not self._came_from(api, vid, branch.approach):
                     continue
-                length = self._lengths.get(vid)
-                if length is None:
-                    length = self._lengths[vid] = float(api.vehicle.getLength(vid))
+                length = vehicle_length(api, self._lengths, vid)
                 back = offset + float(api.vehicle.getLanePosition(vid)) - length
                 if back < length_m:
                     backs.append((vid, back))

@@ -19,6 +19,7 @@ into a :class:`Percept`.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -28,7 +29,7 @@ from numpy.typing import NDArray
 
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.lane_split import SplitSensor
+from explaindrive.env.lane_split import SplitSensor, vehicle_length
 from explaindrive.env.lights import AmberDecision
 from explaindrive.env.right_of_way import NO_YIELD, YieldReading, YieldSensor
 from explaindrive.sim.crossing_lanes import CrossingLane, pedestrian_in_lane
@@ -128,23 +129,24 @@ class LeaderSensor:
         self._lengths = lengths
         self.splits = SplitSensor(lengths)
 
-    def __call__(self, api: Any, ego: Any) -> Leader | None:
+    def __call__(self, api: Any, ego: Any, next_links: Sequence[Any] = ()) -> Leader | None:
         """The real leader from the ego's subscription results ``ego``: SUMO's, or a vehicle
         in the other branch of a lane split that is still in the ego's way
-        (:mod:`explaindrive.env.lane_split`), whichever is nearer."""
+        (:mod:`explaindrive.env.lane_split`; ``next_links``: the ego's
+        ``vehicle.getNextLinks`` this step), whichever is nearer."""
         lead = ego.get(tc.VAR_LEADER)
         gap, lid = S.SENSOR_RANGE_M, ""
         if lead and lead[0]:
             gap, lid = float(lead[1]) + self.ego_min_gap_m, lead[0]
         lane = ego.get(tc.VAR_LANE_ID)
-        split = self.splits(api, lane, float(ego[tc.VAR_LANEPOSITION])) if lane else None
+        split = (
+            self.splits(api, lane, float(ego[tc.VAR_LANEPOSITION]), next_links) if lane else None
+        )
         if split is not None and split[0] < gap:
             gap, lid = split
         if gap >= S.SENSOR_RANGE_M:
             return None
-        length = self._lengths.get(lid)
-        if length is None:
-            length = self._lengths[lid] = float(api.vehicle.getLength(lid))
+        length = vehicle_length(api, self._lengths, lid)
         return Leader(max(gap, 0.0), float(api.vehicle.getSpeed(lid)), length, False)
 
 
@@ -352,7 +354,8 @@ class Perception:
             kerb: the pedestrians waiting for the ego at a zebra.
         """
         v = float(ego[tc.VAR_SPEED])
-        real = self.leaders(api, ego)
+        next_links = api.vehicle.getNextLinks(EGO_ID)
+        real = self.leaders(api, ego, next_links)
         links = signal_links(api)
         light = light_ahead(links)
         at_line = amber.is_leader(light.light_id, light.colour, v, light.gap_m)
@@ -362,7 +365,7 @@ class Perception:
             light = dataclasses.replace(light, colour=shown)
         crossings = self.crossings(api, pos_m, kerb)
         limit = self.geometry.posted_limit(pos_m)
-        yields = self.yields(api, pos_m, v, limit)
+        yields = self.yields(api, pos_m, v, limit, next_links)
         leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m, yields.leader_gap_m)
         obs = observation(command, v, limit, leader, light, crossings.gap_m)
         return Percept(obs, leader, real, links, crossings, true_colour, yields)

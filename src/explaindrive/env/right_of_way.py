@@ -496,29 +496,36 @@ class YieldSensor:
             self._turns[via] = turn_geometry(api, via)
         return self._turns[via]
 
-    def wait_gap(self, junction: str, foe: JunctionFoe, pos_m: float) -> float | None:
+    def turn_at(self, api: Any, junction: str, pos_m: float) -> tuple[TurnGeometry, float] | None:
+        """The turn of the ego's link through ``junction`` and the route position of its stop
+        line [m] (``None``: the link leads to no internal junction, or the passage is
+        behind the ego's front at route position ``pos_m``)."""
+        via = self._vias.get(junction, "")
+        turn = self.turn(api, via) if via else None
+        line_m = self.line_at(junction, pos_m)
+        return None if turn is None or line_m is None else (turn, line_m)
+
+    def wait_gap(self, api: Any, junction: str, foe: JunctionFoe, pos_m: float) -> float | None:
         """[m] From the ego's front (at route position ``pos_m``) to where it waits for
         ``foe``: the stop line of ``junction``, or for a foe of its turn (``foe.turning``) the
         turn's internal junction or the start of their conflict area, whichever comes first
         (``None``: nothing ahead)."""
         if not foe.turning:
             return self.line_gap(junction, pos_m)
-        turn = self._turns.get(self._vias.get(junction, ""))
-        line_m = self.line_at(junction, pos_m)
-        if turn is None or line_m is None:
+        found = self.turn_at(api, junction, pos_m)
+        if found is None:
             return None
-        gap = min(foe.ego_dist_m, line_m + turn.via_m - pos_m)
+        gap = min(foe.ego_dist_m, found[1] + found[0].via_m - pos_m)
         return gap if gap >= 0.0 else None
 
     def turn_foes(self, api: Any, junction: str, pos_m: float) -> list[JunctionFoe]:
         """The foes with priority at the internal junction of the ego's turn through
         ``junction`` (module docstring): the vehicles on a foe's incoming lane bound for its
         crossing via lane, and those on that via lane."""
-        via = self._vias.get(junction, "")
-        turn = self.turn(api, via) if via else None
-        line_m = self.line_at(junction, pos_m)
-        if turn is None or line_m is None:
+        found = self.turn_at(api, junction, pos_m)
+        if found is None:
             return []
+        turn, line_m = found
         foes: list[JunctionFoe] = []
         for incoming, foe_via, foe_at, ego_at in turn.foes:
             to_entry = float(api.lane.getLength(incoming))
@@ -549,12 +556,20 @@ class YieldSensor:
             found.extend(self.turn_foes(api, junction, pos_m))
         return found
 
-    def __call__(self, api: Any, pos_m: float, speed_mps: float, limit_mps: float) -> YieldReading:
+    def __call__(
+        self,
+        api: Any,
+        pos_m: float,
+        speed_mps: float,
+        limit_mps: float,
+        next_links: Sequence[Any],
+    ) -> YieldReading:
         """The yield lines ahead of the ego's front (at route position ``pos_m``) where it
         must yield now (:func:`must_yield`), the nearest it can still stop before being a
         leader, and the conflict areas it may enter in the coming step with a foe that has
-        priority (for :func:`enters_in_front`)."""
-        states, reach = self.horizon(api.vehicle.getNextLinks(EGO_ID), pos_m)
+        priority (for :func:`enters_in_front`); ``next_links``: the ego's
+        ``vehicle.getNextLinks`` this step."""
+        states, reach = self.horizon(next_links, pos_m)
         if not states:
             return NO_YIELD
         entry_reach_m = (speed_mps + MAX_ACCEL_MPS) * STEP_LENGTH_S  # the most a step covers
@@ -568,7 +583,7 @@ class YieldSensor:
             if 0.0 < foe.ego_dist_m <= entry_reach_m:
                 motion = self.foe_motion(api, foe)
                 conflicts.append(Conflict(foe, motion))
-            gap = self.wait_gap(junction, foe, pos_m)
+            gap = self.wait_gap(api, junction, foe, pos_m)
             if gap is None or gap >= leader or not can_stop_before(speed_mps, gap):
                 continue
             motion = motion or self.foe_motion(api, foe)

@@ -16,7 +16,6 @@ from __future__ import annotations
 import subprocess
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 
 from explaindrive.evaluation.aggregate import summarize
@@ -29,6 +28,7 @@ from explaindrive.evaluation.scenarios import (
 )
 from explaindrive.evaluation.spec import PolicySpec, RunPlan, plan_run
 from explaindrive.evaluation.tables import fmt
+from explaindrive.sim.scenario.files import package_data_dir
 from explaindrive.sim.sumo_home import sumo_binary
 
 HELD_OUT = "random:100-119"
@@ -87,8 +87,7 @@ def built_network(network: BuiltNetwork, cache_dir: Path) -> Path:
     if not out.is_file():
         out.parent.mkdir(parents=True, exist_ok=True)
         if network.osm:
-            osm = resources.files("explaindrive.sim.scenario") / "data" / network.osm
-            tool = [sumo_binary("netconvert"), "--osm-files", str(osm)]
+            tool = [sumo_binary("netconvert"), "--osm-files", str(package_data_dir() / network.osm)]
         else:
             tool = [sumo_binary("netgenerate"), "--seed", "7"]
         args = [*tool, *network.options, "--no-turnarounds", "true", "-o", str(out)]
