@@ -47,23 +47,13 @@ import zipfile
 from collections import Counter
 from pathlib import Path
 
-from explaindrive.language.data import (
-    BLIND_CSV,
-    FORMER_HELDOUT_CSVS,
-    HELDOUT_CSV,
-    TEST_CSV,
-    TRAIN_CSV,
-    WRITTEN_CSV,
-    data_path,
-)
+from explaindrive.language.data import HELDOUT_CSV, LABELLED_CSVS, data_path
 from explaindrive.language.intent.corpus import near_copies, read_lines
 
 DATA = Path(__file__).resolve().parents[1] / "src" / "explaindrive" / "language" / "data"
 TRAIN_FILE = "everyday_train.csv.gz"
 CHECK_FILE = "everyday_check.csv.gz"
 CHECK_SIZE = 3000  # messages drawn for the external check
-LABELLED = (TRAIN_CSV, WRITTEN_CSV, *FORMER_HELDOUT_CSVS, HELDOUT_CSV, TEST_CSV, BLIND_CSV)
-"""The labelled files: a check message that is also one of their lines is left out."""
 CHECK_DRAW = 1
 """The check is block ``CHECK_DRAW`` of ``CHECK_SIZE`` messages in a seeded draw; the blocks
 before it were scored and their errors read, so they are development lines, used for
@@ -196,7 +186,9 @@ def main(argv: list[str] | None = None) -> int:
 
     messages = [m for m in dict.fromkeys(chitchat(args.wheels)) if _usable(m)]
     drawn = random.Random(0).sample(messages, CHECK_SIZE * (CHECK_DRAW + 1))
-    labelled = {row["text"].lower() for name in LABELLED for row in read_lines(data_path(name))}
+    labelled = {
+        row["text"].lower() for name in LABELLED_CSVS for row in read_lines(data_path(name))
+    }
     block = drawn[CHECK_SIZE * CHECK_DRAW :]
     check = [t for t in block if t.lower() not in labelled]
     overlap = {t.lower() for t in block} & seen

@@ -36,6 +36,10 @@ BLIND_CSV = "commands_blind.csv"
 """A development split of negated stops, complaints, self-corrections, hedges, typos,
 speech-recognition errors and off-topic remarks with driving words (scored as a test split
 once, read since): calibration only."""
+DEVELOPMENT_CSVS = (TEST_CSV, BLIND_CSV)
+"""The development splits LLM-1 is calibrated on, never trained on."""
+LABELLED_CSVS = (TRAIN_CSV, WRITTEN_CSV, *FORMER_HELDOUT_CSVS, *DEVELOPMENT_CSVS, HELDOUT_CSV)
+"""Every file of labelled lines (the test split last)."""
 DECISIONS_JSONL = "decisions.jsonl"
 """Labelled state records for the LLM-2 trigger and the LLM-3 explanations."""
 INTENT_MODEL = "intent_model.npz"

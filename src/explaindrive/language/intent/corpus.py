@@ -30,18 +30,16 @@ from difflib import SequenceMatcher
 from pathlib import Path
 
 from explaindrive.language.data import (
-    BLIND_CSV,
+    DEVELOPMENT_CSVS,
     EVERYDAY_CHECK,
     EVERYDAY_TRAIN,
     FORMER_HELDOUT_CSVS,
-    TEST_CSV,
     TRAIN_CSV,
     WRITTEN_CSV,
     data_path,
 )
 from explaindrive.language.intent.model import READINGS
 
-DEVELOPMENT = (TEST_CSV, BLIND_CSV)
 RESERVE = "reserve"
 NEAR_COPY = 0.8
 """Character similarity (difflib's ratio, either way round) from which a line counts as a
@@ -117,7 +115,7 @@ def calibration_pool() -> list[Example]:
     trained = {e.text.lower() for e in labelled} | {e.text.lower() for e in everyday}
     pool = [e for e, row in _labelled(data_path(TRAIN_CSV)) if row.get("split") == RESERVE]
     pool += [e for e, _ in _labelled(data_path(WRITTEN_CSV)) if _held_out(e.text)]
-    for name in DEVELOPMENT:
+    for name in DEVELOPMENT_CSVS:
         pool += [e for e, _ in _labelled(data_path(name))]
     pool += [
         Example(row["text"], "none", f"{EVERYDAY_TRAIN}:{row['source']}")
