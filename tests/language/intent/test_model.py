@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from explaindrive.language.intent.adapter import AdapterSpec, merge
-from explaindrive.language.intent.calibration import choose_thresholds, curve
+from explaindrive.language.intent.calibration import choose_thresholds, curve, stop_threshold
 from explaindrive.language.intent.model import READINGS, IntentModel, Thresholds
 from explaindrive.language.intent.stop_path import names_stop
 
@@ -112,6 +112,19 @@ def test_thresholds_weigh_missed_stops_and_bound_false_commands() -> None:
     rows += [_p(stop=0.6, none=0.4), _p(stop=0.45, none=0.55)]
     labels += ["stop", "stop"]
     assert choose_thresholds(model, np.array(rows), labels)[0].stop == pytest.approx(0.30)
+
+
+def test_the_stop_threshold_reads_at_most_one_in_a_thousand_lines_as_stop() -> None:
+    # one STOP request at p(stop) 0.45; 3 of 1,000 lines without a command at 0.5.
+    # Costs: up to 0.45, 3 false STOPs; 0.46-0.50, 5 + 3; from 0.51, 5. Least cost is 0.30,
+    # but 3 > 0.1 % of 1,000: of the thresholds with at most 1 false STOP, 0.51 costs least
+    negative = np.array([0.5] * 3 + [0.01] * 997)
+    assert stop_threshold(np.array([0.45]), negative) == pytest.approx(0.51)
+    # with 3,000 such lines 3 false STOPs are allowed, and 0.30 is chosen
+    more = np.concatenate([negative, np.full(2000, 0.01)])
+    assert stop_threshold(np.array([0.45]), more) == pytest.approx(0.30)
+    # no threshold of the grid keeps under the cap: the highest
+    assert stop_threshold(np.array([0.45]), np.array([1.0, 1.0])) == pytest.approx(0.99)
 
 
 @pytest.mark.parametrize(
