@@ -163,11 +163,42 @@ def _write_gz(path: Path, header: list[str], rows: list[tuple[str, ...]]) -> Non
         fh.write(buffer.getvalue().encode("utf-8"))
 
 
+def _check_block(wheels: Path) -> tuple[list[str], int]:
+    """Block :data:`CHECK_DRAW` of the seeded draw, less lines of the labelled files; and
+    how many chitchat messages it was drawn from."""
+    messages = [m for m in dict.fromkeys(chitchat(wheels)) if _usable(m)]
+    drawn = random.Random(0).sample(messages, CHECK_SIZE * (CHECK_DRAW + 1))
+    labelled = {
+        row["text"].lower() for name in LABELLED_CSVS for row in read_lines(data_path(name))
+    }
+    return [t for t in drawn[CHECK_SIZE * CHECK_DRAW :] if t.lower() not in labelled], len(messages)
+
+
+def _check_only(wheels: Path, out: Path) -> int:
+    block, n = _check_block(wheels)
+    trained = {row["text"].lower() for row in read_lines(out / TRAIN_FILE)}
+    check = [t for t in block if t.lower() not in trained]
+    _write_gz(out / CHECK_FILE, ["text", "source"], [(t, "chitchat-dataset") for t in check])
+    print(
+        f"check: {len(check)} of {n} chitchat messages (block {CHECK_DRAW}, less lines of the "
+        f"labelled files and {len(block) - len(check)} of the everyday pool)"
+    )
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("wheels", type=Path, help="folder of the downloaded wheels")
     ap.add_argument("--out", type=Path, default=DATA)
+    ap.add_argument(
+        "--check-only",
+        action="store_true",
+        help="write only the check, leaving out the lines of the training pool in --out "
+        "as it stands (the shipped model was trained on it)",
+    )
     args = ap.parse_args(argv)
+    if args.check_only:
+        return _check_only(args.wheels, args.out)
 
     seen: set[str] = set()
     rows: list[tuple[str, str, str]] = []
@@ -184,14 +215,8 @@ def main(argv: list[str] | None = None) -> int:
                 continue
             rows.append((text, source, "calibration" if _calibration(text) else "train"))
 
-    messages = [m for m in dict.fromkeys(chitchat(args.wheels)) if _usable(m)]
-    drawn = random.Random(0).sample(messages, CHECK_SIZE * (CHECK_DRAW + 1))
-    labelled = {
-        row["text"].lower() for name in LABELLED_CSVS for row in read_lines(data_path(name))
-    }
-    block = drawn[CHECK_SIZE * CHECK_DRAW :]
-    check = [t for t in block if t.lower() not in labelled]
-    overlap = {t.lower() for t in block} & seen
+    check, n_messages = _check_block(args.wheels)
+    overlap = {t.lower() for t in check} & seen
     rows = [r for r in rows if r[0].lower() not in overlap]  # the check stays unseen
     tests = [row["text"] for row in read_lines(data_path(HELDOUT_CSV))]
     near = near_copies(tests, [r[0] for r in rows])
@@ -206,7 +231,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"dropped: {dict(dropped)}; removed as in the check: {len(overlap)}", end="")
     print(f", as near the test split: {len(near)}")
     print(
-        f"check: {len(check)} of {len(messages)} chitchat messages (block {CHECK_DRAW}, "
+        f"check: {len(check)} of {n_messages} chitchat messages (block {CHECK_DRAW}, "
         "less lines of the labelled files)"
     )
     return 0
