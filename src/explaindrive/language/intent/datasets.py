@@ -23,7 +23,13 @@ INTENT_LABELS: tuple[str, ...] = ("fast", "comfort", "stop", "none")
 TRAIN_SPLIT = "train"
 DEV_PREFIX = "dev-"
 RESERVE_SPLIT = "reserve"
-_SPLIT = re.compile(rf"{TRAIN_SPLIT}|{RESERVE_SPLIT}|{DEV_PREFIX}[1-9][0-9]*")
+UNSEEN_SPLIT = "unseen"
+"""Of a test split: a line with no near-copy among the lines a model learns or is calibrated
+from (``intent.corpus.near_copies``) when the split was committed; ``near`` one with one."""
+NEAR_SPLIT = "near"
+_SPLIT = re.compile(
+    rf"{TRAIN_SPLIT}|{RESERVE_SPLIT}|{UNSEEN_SPLIT}|{NEAR_SPLIT}|{DEV_PREFIX}[1-9][0-9]*"
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,7 +70,7 @@ def load_commands(path: str | Path) -> list[CommandExample]:
         if "split" in columns and not _SPLIT.fullmatch(split):
             raise ValueError(
                 f"{p}:{line}: unknown split {split!r}; expected {TRAIN_SPLIT}, "
-                f"{DEV_PREFIX}<k> or {RESERVE_SPLIT}"
+                f"{DEV_PREFIX}<k>, {RESERVE_SPLIT}, {UNSEEN_SPLIT} or {NEAR_SPLIT}"
             )
         out.append(CommandExample(row["text"], label, row.get("kind", ""), split))
     return out
