@@ -2,8 +2,8 @@
 
 * Requests (``commands_train.csv``): labelled passenger requests; its ``reserve`` split is
   kept for calibration. The development splits ``commands_heldout.csv``,
-  ``commands_heldout2.csv`` and ``commands_heldout3.csv`` (the previous test splits) are
-  trained on whole.
+  ``commands_heldout2.csv``, ``commands_heldout3.csv`` and ``commands_heldout4.csv`` (the
+  previous test splits) are trained on whole.
 * Written lines (``commands_written.csv``): in-car chatter and phone talk that use pace and
   stopping words in other senses, questions about the car's behaviour (``why``), answers
   to a confirmation (``yes`` / ``no``), negated requests; one line in seven (by a hash of
@@ -14,7 +14,7 @@
 * The development splits ``commands_test.csv`` and ``commands_blind.csv`` are calibrated on,
   never trained on.
 
-The test split ``commands_heldout4.csv`` and the external check ``everyday_check.csv.gz``
+The test split ``commands_heldout5.csv`` and the external check ``everyday_check.csv.gz``
 are read by the evaluation only.
 """
 
