@@ -36,11 +36,11 @@ def test_the_real_leader_gap_adds_the_ego_min_gap_and_lengths_are_read_once() ->
     api = FakeSumo(vehicles={"car": (4.5, 7.0)})
     sensor = LeaderSensor(ego_min_gap_m=2.5, lengths={})
     for _ in range(2):
-        assert sensor(api, ego_results(10.0, ("car", 12.0))) == Leader(14.5, 7.0, 4.5, False)
+        assert sensor(api, ego_results(10.0, ("car", 12.0)), ()) == Leader(14.5, 7.0, 4.5, False)
     assert api.length_reads == 1
-    assert sensor(api, ego_results(10.0)) is None  # nobody ahead
-    assert sensor(api, ego_results(10.0, ("car", 197.5))) is None  # 200 m: out of range
-    assert sensor(api, ego_results(10.0, ("car", -4.0))).gap_m == 0.0  # overlap reads as 0
+    assert sensor(api, ego_results(10.0), ()) is None  # nobody ahead
+    assert sensor(api, ego_results(10.0, ("car", 197.5)), ()) is None  # 200 m: out of range
+    assert sensor(api, ego_results(10.0, ("car", -4.0)), ()).gap_m == 0.0  # overlap reads as 0
 
 
 def test_the_light_ahead_is_the_nearest_link_of_the_ego_with_its_own_signal() -> None:

@@ -129,7 +129,7 @@ class LeaderSensor:
         self._lengths = lengths
         self.splits = SplitSensor(lengths)
 
-    def __call__(self, api: Any, ego: Any, next_links: Sequence[Any] = ()) -> Leader | None:
+    def __call__(self, api: Any, ego: Any, next_links: Sequence[Any]) -> Leader | None:
         """The real leader from the ego's subscription results ``ego``: SUMO's, or a vehicle
         in the other branch of a lane split that is still in the ego's way
         (:mod:`explaindrive.env.lane_split`; ``next_links``: the ego's

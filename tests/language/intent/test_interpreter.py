@@ -34,7 +34,7 @@ def test_template_round_trip() -> None:
             True,
             marks=pytest.mark.xfail(
                 strict=True,
-                reason="the shipped LLM-1 reads it as no command (0.67) over yes (0.31)",
+                reason="the shipped LLM-1 reads it as no command (0.52) over yes (0.46)",
             ),
         ),
         ("No.", False),
