@@ -1,9 +1,8 @@
 """The lines LLM-1 learns from and is calibrated on, read from ``language/data``.
 
 * Requests (``commands_train.csv``): labelled passenger requests; its ``reserve`` split is
-  kept for calibration. The development splits ``commands_heldout.csv``,
-  ``commands_heldout2.csv``, ``commands_heldout3.csv`` and ``commands_heldout4.csv`` (the
-  previous test splits) are trained on whole.
+  kept for calibration. The previous test splits (``FORMER_HELDOUT_CSVS``, development
+  splits now) are trained on whole.
 * Written lines (``commands_written.csv``): in-car chatter and phone talk that use pace and
   stopping words in other senses, questions about the car's behaviour (``why``), answers
   to a confirmation (``yes`` / ``no``), negated requests; one line in seven (by a hash of
@@ -14,7 +13,7 @@
 * The development splits ``commands_test.csv`` and ``commands_blind.csv`` are calibrated on,
   never trained on.
 
-The test split ``commands_heldout5.csv`` and the external check ``everyday_check.csv.gz``
+The test split (``HELDOUT_CSV``) and the external check ``everyday_check.csv.gz``
 are read by the evaluation only.
 """
 
