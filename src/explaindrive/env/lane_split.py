@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
 from explaindrive.env import state as S
@@ -58,12 +58,17 @@ def shared_stretch_m(
     return along
 
 
+def read_once(cache: dict[str, float], key: str, read: Callable[[str], Any]) -> float:
+    """``read(key)`` as a float, read once and kept in ``cache`` (SUMO's fixed lengths)."""
+    value = cache.get(key)
+    if value is None:
+        value = cache[key] = float(read(key))
+    return value
+
+
 def vehicle_length(api: Any, lengths: dict[str, float], vid: str) -> float:
     """[m] Vehicle ``vid``'s length, read from SUMO once and kept in ``lengths``."""
-    length = lengths.get(vid)
-    if length is None:
-        length = lengths[vid] = float(api.vehicle.getLength(vid))
-    return length
+    return read_once(lengths, vid, api.vehicle.getLength)
 
 
 class Branch(NamedTuple):
@@ -130,10 +135,7 @@ class SplitSensor:
         elif lane.startswith(":"):
             return None
         else:
-            length = self._lane_lengths.get(lane)
-            if length is None:
-                length = self._lane_lengths[lane] = float(api.lane.getLength(lane))
-            to_start = length - lane_pos_m
+            to_start = read_once(self._lane_lengths, lane, api.lane.getLength) - lane_pos_m
             if to_start >= S.SENSOR_RANGE_M or not next_links:
                 return None
             via = str(next_links[0][4])
