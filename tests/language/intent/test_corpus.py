@@ -41,3 +41,17 @@ def test_the_calibration_pool_is_never_trained_on() -> None:
     assert labels == {"fast", "comfort", "stop", "none", "why", "yes", "no"}
     checked = set(external_check())
     assert len(checked) >= 1000 and not checked & (trained | {e.text for e in pool})
+
+
+def test_answers_and_questions_about_the_car_are_learned_as_readings_not_as_none() -> None:
+    labelled, _ = training_pool()
+    # the former test splits label "No." and "Why did you brake?" none (no command); the
+    # training pool takes those readings from commands_written.csv alone
+    sources = {e.source.split(":")[0] for e in labelled if e.source.endswith((":why", ":answer"))}
+    assert not any(name.startswith("commands_heldout") for name in sources)
+    by_text: dict[str, set[str]] = {}
+    for e in labelled:
+        by_text.setdefault(e.text.lower(), set()).add(e.label)
+    assert by_text["no."] == {"no"}  # commands_heldout5.csv holds "No." labelled none
+    readings = {t for t, labels in by_text.items() if labels & {"why", "yes", "no"}}
+    assert all(len(by_text[t]) == 1 for t in readings)  # no line is taught two readings
