@@ -122,7 +122,6 @@ def test_stop_reward_terms_only_hold_the_stop_term():
         "brake": 0.0,
         "approach": 0.0,
         "cruise": 0.0,
-        "follow": 0.0,
         "total": -50.0,
     }
 
@@ -189,41 +188,6 @@ def test_passenger_cruise_charges_a_slow_free_road(speed_mps, free, fast, comfor
     assert R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE).cruise == pytest.approx(fast)
     assert R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE).cruise == pytest.approx(comfort)
     assert R.reward_terms(Command.FAST, f).cruise == 0.0  # the paper's reward has no such term
-
-
-@pytest.mark.parametrize(
-    ("speed_mps", "leader_mps", "gap_m", "fast"),
-    [
-        # room 10 - 2 - 1 s x 2 m/s = 6 m; v_ok = 2 - 1.5 + sqrt(1.5^2 + 2 x 1.5 x 6) = 5
-        (0.0, 2.0, 10.0, -3 * 5 / 10),  # standing while the queue ahead pulls away
-        (4.0, 2.0, 10.0, -3 * 1 / 10),
-        (5.0, 2.0, 10.0, 0.0),
-        (6.0, 2.0, 10.0, 0.0),  # closing in: the approach term's business
-        (0.0, 0.0, 10.0, 0.0),  # a standing queue: no charge
-        (0.0, 0.05, 10.0, 0.0),  # nor a leader creeping slower than 0.1 m/s
-        # room 16 - 2 - 8 = 6 m: v_ok = 8 + 3 = 11, capped at 90 % of the 10 m/s limit
-        (7.0, 8.0, 16.0, -3 * 2 / 10),
-        (2.0, 2.0, 4.0, 0.0),  # no room beyond the time gap: v_ok is the leader's speed
-    ],
-)
-def test_passenger_fast_follow_charges_trailing_a_moving_leader(speed_mps, leader_mps, gap_m, fast):
-    f = _features(
-        speed_mps=speed_mps, limit_mps=10.0, leader_gap_m=gap_m,
-        closing_speed_mps=speed_mps - leader_mps,
-    )  # fmt: skip
-    assert R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE).follow == pytest.approx(fast)
-    assert R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE).follow == 0.0  # fast only
-    assert R.reward_terms(Command.FAST, f).follow == 0.0  # the paper's reward has no such term
-
-
-def test_follow_is_not_charged_before_a_stop_line_or_on_a_free_road():
-    base = dict(speed_mps=0.0, limit_mps=10.0, leader_gap_m=10.0, closing_speed_mps=-2.0)
-    for extra in ({"leader_virtual": True}, {"free_road": True}):
-        f = _features(**base, **extra)
-        assert R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE).follow == 0.0
-    assert R.uncharged_speed(10.0, 2.0, 1.0, 1.5) == pytest.approx(5.0)
-    # without a time gap the room is 8 m: v_ok = 2 + sqrt(2 x 1.5 x 8)
-    assert R.uncharged_speed(10.0, 2.0, 0.0, 1.5) == pytest.approx(2.0 + 4.898979, abs=1e-6)
 
 
 def test_needed_deceleration():

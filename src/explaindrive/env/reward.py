@@ -25,9 +25,6 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
   yellow ahead calls for the gentlest deceleration that stops at the line, not a harder one;
 * driving below 90 % of the limit on a free road is charged (``cruise``): on an open road a
   passenger expects the car to go;
-* under fast, trailing a moving vehicle slower than the gap allows is charged (``follow``):
-  the car should drive as fast as it could without an ``approach`` charge (up to 90 % of
-  the limit), so that it leaves a queue with it and keeps up with the traffic ahead;
 * comfort's progress is worth as much as fast's: the two differ in smoothness.
 """
 
@@ -61,7 +58,6 @@ APPROACH_FREE_DECEL_MPS2 = 1.5  # [m/s^2] ``approach`` charges no stop needing u
 APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
 MAX_NEEDED_MPS2 = 9.0  # [m/s^2] SUMO's emergency braking: ``approach`` charges no further
 CRUISE_SHARE = 0.9  # of the posted limit: ``cruise`` charges free-road driving below it
-FOLLOW_MOVING_MPS = 0.1  # [m/s] ``follow`` charges only behind a leader at least this fast
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,8 +80,6 @@ class RewardWeights:
             clear of a vehicle ahead besides :data:`APPROACH_STANDSTILL_M` (not of a stop
             line).
         cruise: weight of -(:data:`CRUISE_SHARE` - v / v_lim) on a free road below it.
-        follow: weight of -(v_ok - v) / v_lim behind a moving vehicle, where v_ok is the
-            speed the ``approach`` term would just not charge (:func:`follow_penalty`).
         signal_stop: paid per step standing for a light or a pedestrian.
         stop_window_m: ``(min, max)`` distance to the line within which ``signal_stop`` is
             paid; ``None`` pays it at any distance (the paper).
@@ -102,7 +96,6 @@ class RewardWeights:
     approach_free_mps2: float = APPROACH_FREE_DECEL_MPS2
     approach_time_gap_s: float = 0.0
     cruise: float = 0.0
-    follow: float = 0.0
     signal_stop: float = R_RESPECT
     stop_window_m: tuple[float, float] | None = None
 
@@ -172,7 +165,6 @@ PASSENGER_RECIPE = RewardRecipe(
         approach=0.3,
         approach_time_gap_s=1.0,
         cruise=3.0,
-        follow=3.0,
         signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
     ),
@@ -305,41 +297,6 @@ def cruise_penalty(speed_mps: float, limit_mps: float, free_road: bool, weight: 
     return -weight * max(0.0, CRUISE_SHARE - speed_mps / limit_mps)
 
 
-def uncharged_speed(
-    gap_m: float, leader_speed_mps: float, time_gap_s: float, free_mps2: float
-) -> float:
-    """The highest speed [m/s] behind a leader at ``gap_m`` whose :func:`approach_penalty`
-    (keeping ``time_gap_s`` at that speed) stays zero: the root of
-    (v - v_l)^2 = 2 a (gap - s0 - T v), at least the leader's speed."""
-    room = gap_m - APPROACH_STANDSTILL_M - time_gap_s * leader_speed_mps
-    if room <= 0.0:
-        return leader_speed_mps
-    at = free_mps2 * time_gap_s
-    return leader_speed_mps - at + math.sqrt(at * at + 2.0 * free_mps2 * room)
-
-
-def follow_penalty(
-    speed_mps: float,
-    limit_mps: float,
-    gap_m: float,
-    leader_speed_mps: float,
-    weight: float,
-    time_gap_s: float,
-    free_mps2: float = APPROACH_FREE_DECEL_MPS2,
-) -> float:
-    """-weight * (v_ok - v) / v_lim behind a leader moving at least
-    :data:`FOLLOW_MOVING_MPS`, where v_ok is :func:`uncharged_speed` capped at
-    :data:`CRUISE_SHARE` of the limit; 0 at or above v_ok."""
-    if weight == 0.0 or limit_mps <= 0.0 or leader_speed_mps < FOLLOW_MOVING_MPS:
-        return 0.0
-    if not math.isfinite(gap_m):
-        return 0.0
-    v_ok = min(
-        uncharged_speed(gap_m, leader_speed_mps, time_gap_s, free_mps2), CRUISE_SHARE * limit_mps
-    )
-    return -weight * max(0.0, v_ok - speed_mps) / limit_mps
-
-
 def collision_reward(collided: bool) -> float:
     """-r_critical on a collision."""
     return -R_CRITICAL if collided else 0.0
@@ -390,7 +347,6 @@ class RewardTerms:
     brake: float = 0.0
     approach: float = 0.0
     cruise: float = 0.0
-    follow: float = 0.0
 
     @property
     def total(self) -> float:
@@ -447,15 +403,4 @@ def reward_terms(
             w.approach_free_mps2,
         ),
         cruise=cruise_penalty(f.speed_mps, f.limit_mps, f.free_road, w.cruise),
-        follow=0.0
-        if f.leader_virtual or f.free_road
-        else follow_penalty(
-            f.speed_mps,
-            f.limit_mps,
-            f.leader_gap_m,
-            f.speed_mps - f.closing_speed_mps,
-            w.follow,
-            w.approach_time_gap_s,
-            w.approach_free_mps2,
-        ),
     )
