@@ -29,14 +29,7 @@ def test_template_round_trip() -> None:
     [
         ("Yes", True),
         ("yeah, that's right", True),
-        pytest.param(
-            "sure, no problem",
-            True,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="the shipped LLM-1 reads it as no command (0.52) over yes (0.46)",
-            ),
-        ),
+        ("sure, no problem", True),
         ("No.", False),
         ("that's not correct", False),
         ("nope, cancel", False),
