@@ -50,24 +50,6 @@ def test_features_are_taken_to_the_effective_leader() -> None:
 
 
 @pytest.mark.parametrize(
-    ("leader", "reason"),
-    [
-        (Leader(9.4, 0.3, 5.0, False), "drive_off"),  # creeping off, 9.4 m >= the 3 m needed
-        (Leader(3.0, 0.3, 5.0, False), "drive_off"),  # 1 m/s + 0 m braking + 2 m margin = 3 m
-        (Leader(2.9, 0.3, 5.0, False), "queue"),  # no room to move off yet
-        (Leader(9.4, 0.1, 5.0, False), "queue"),  # at 0.1 m/s it still counts as standing
-        (Leader(9.4, 0.3, 0.0, True), "signal"),
-        (Leader(15.1, 0.0, 5.0, False), None),  # too far to justify standing
-    ],
-)
-def test_the_stop_reason_of_a_leader_that_drives_off(leader: Leader, reason: str | None) -> None:
-    standing = Motion(0.0, collided=False, arrived=False, ego=None)
-    no_violation = Violations(False, False, "signal")
-    rec = StepRecord(Command.FAST, 0, 0.0, 0.0, standing, leader, leader, 13.89, no_violation)
-    assert rec.features().stop_reason == reason
-
-
-@pytest.mark.parametrize(
     ("violations", "traffic"),
     [
         (Violations(False, False, "yield_junction", yield_violation=True), -10.0),

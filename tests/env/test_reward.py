@@ -62,14 +62,6 @@ def test_traffic_rules_reward():
     assert R.traffic_rules_reward(violation=False, stopped=True, stop_reason="queue") == 0.0
     assert R.traffic_rules_reward(violation=False, stopped=True, stop_reason=None) == -10.0
     assert R.traffic_rules_reward(violation=False, stopped=False, stop_reason=None) == 0.0
-    # behind a leader that drives off: justified in the paper, a stop without reason when not
-    assert R.traffic_rules_reward(violation=False, stopped=True, stop_reason="drive_off") == 0.0
-    charged = R.traffic_rules_reward(
-        violation=False, stopped=True, stop_reason="drive_off", wait_for_drive_off=False
-    )
-    assert charged == -10.0
-    assert not R.PASSENGER_RECIPE.fast.wait_for_drive_off
-    assert R.PASSENGER_RECIPE.comfort.wait_for_drive_off and R.PAPER_RECIPE.fast.wait_for_drive_off
 
 
 def test_stop_reward():

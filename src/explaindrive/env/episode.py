@@ -11,12 +11,11 @@ import numpy as np
 
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.actions import STEP_LENGTH_S, stopping_need
+from explaindrive.env.actions import STEP_LENGTH_S
 from explaindrive.env.lights import AmberDecision
 from explaindrive.env.noise import ObservationNoise
 from explaindrive.env.perception import Leader, Percept, Perception
 from explaindrive.env.reward import (
-    DRIVE_OFF_MPS,
     STOP_REASON_GAP_M,
     StepFeatures,
     time_headway,
@@ -125,12 +124,6 @@ class StepRecord:
         stop_reason: str | None = None
         if leader is not None and leader.gap_m <= STOP_REASON_GAP_M:
             stop_reason = "signal" if leader.virtual else "queue"
-            if (
-                not leader.virtual
-                and leader.speed_mps > DRIVE_OFF_MPS
-                and leader.gap_m >= stopping_need(1.0)
-            ):
-                stop_reason = "drive_off"  # room to move off at the slowest step behind it
         return StepFeatures(
             speed_mps=v,
             speed_change_mps=self.change,

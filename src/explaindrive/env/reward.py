@@ -53,7 +53,6 @@ COMFORT_CF_WEIGHTS = (2.0, 1.5)
 FAST_SPEED_WEIGHT = 3.0
 COMFORT_SPEED_WEIGHT = 1.5
 STOP_REASON_GAP_M = 15.0  # [m] a leader this close justifies standing still
-DRIVE_OFF_MPS = 0.1  # [m/s] a real leader faster than this has driven off (SUMO stands at 0)
 GENTLE_BRAKE_MPS2 = 1.0  # [m/s^2] braking up to this is not charged by ``hard_brake``
 APPROACH_FREE_DECEL_MPS2 = 1.5  # [m/s^2] ``approach`` charges no stop needing up to this (default)
 APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
@@ -84,10 +83,6 @@ class RewardWeights:
         signal_stop: paid per step standing for a light or a pedestrian.
         stop_window_m: ``(min, max)`` distance to the line within which ``signal_stop`` is
             paid; ``None`` pays it at any distance (the paper).
-        wait_for_drive_off: whether a real leader within :data:`STOP_REASON_GAP_M` that
-            drives off still justifies standing (the paper: any leader that close does);
-            ``False``: standing behind it once there is room to move off is a stop without
-            reason (``stop_reason="drive_off"``).
     """
 
     ttc: float
@@ -103,7 +98,6 @@ class RewardWeights:
     cruise: float = 0.0
     signal_stop: float = R_RESPECT
     stop_window_m: tuple[float, float] | None = None
-    wait_for_drive_off: bool = True
 
 
 @dataclass(frozen=True, slots=True)
@@ -173,7 +167,6 @@ PASSENGER_RECIPE = RewardRecipe(
         cruise=3.0,
         signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
-        wait_for_drive_off=False,
     ),
     comfort=RewardWeights(
         *COMFORT_CF_WEIGHTS,
@@ -243,7 +236,6 @@ def traffic_rules_reward(
     stopped: bool,
     stop_reason: str | None,
     signal_stop: float = R_RESPECT,
-    wait_for_drive_off: bool = True,
 ) -> float:
     """R_traffic: -r_unsafe for a violation or a stop without reason, ``signal_stop``
     (the paper: +r_respect) for a stop at a red light or for a pedestrian.
@@ -255,17 +247,15 @@ def traffic_rules_reward(
         stopped: the ego stands still after the step.
         stop_reason: why standing still is justified: ``"signal"`` (red/yellow light or
             pedestrian, i.e. the virtual leader), ``"queue"`` (a real vehicle close
-            ahead), ``"drive_off"`` (a real vehicle close ahead that drives off, with room
-            to follow it) or ``None``.
+            ahead) or ``None``.
         signal_stop: what a stop for a signal pays.
-        wait_for_drive_off: whether ``"drive_off"`` justifies standing.
     """
     if violation:
         return -R_UNSAFE
     if stopped:
         if stop_reason == "signal":
             return signal_stop
-        if stop_reason is None or (stop_reason == "drive_off" and not wait_for_drive_off):
+        if stop_reason is None:
             return -R_UNSAFE
     return 0.0
 
@@ -400,7 +390,6 @@ def reward_terms(
             stopped=f.speed_mps <= 0.0,
             stop_reason=f.stop_reason,
             signal_stop=_signal_stop(w, f.leader_gap_m),
-            wait_for_drive_off=w.wait_for_drive_off,
         ),
         speed=speed_reward(f.speed_mps, f.limit_mps, w.speed),
         collision=collision_reward(f.collided),
