@@ -204,7 +204,7 @@ ADDED_FIELDS = {
     "priority_alpha": 0.0, "priority_beta": 0.4, "priority_beta_steps": 400_000,
     "boundary_weight": 0.0, "boundary_margin": None, "limit_margin": None, "n_step_cut": False,
     "boundary_noise": False, "speed_noisy_share": None, "near_range_m": None,
-    "near_dv_mps": None, "speed_estimate": False, "stop_window_m": None, "speed_limiter": False,
+    "speed_estimate": False, "stop_window_m": None, "speed_limiter": False,
 }  # fmt: skip
 """Fields added after the shipped cards were written, with their defaults (uniform replay)."""
 

@@ -36,21 +36,19 @@ def test_policy_round_trip_and_raw_observations(tmp_path: Path) -> None:
 
 def test_policy_round_trip_keeps_the_near_range_features(tmp_path: Path) -> None:
     torch.manual_seed(0)
-    net = DuelingQNetwork((8,), near_range_m=12.5, near_dv_mps=2.0)
+    net = DuelingQNetwork((8,), near_range_m=12.5)
     path, _ = save_policy(tmp_path / "near", net, {})
     loaded, _ = load_policy(path)
-    assert loaded.near_range_m == 12.5 and loaded.near_dv_mps == 2.0
+    assert loaded.near_range_m == 12.5
     x = torch.from_numpy(OBS[None])
     assert torch.equal(loaded(x), net(x))
     # a file written before the option holds no such entry: the 8 components alone
     payload = torch.load(path, weights_only=False)
     plain = DuelingQNetwork((8,))
     payload.pop("near_range_m")
-    payload.pop("near_dv_mps")
     payload["state_dict"] = plain.state_dict()
     torch.save(payload, path)
-    loaded, _ = load_policy(path)
-    assert loaded.near_range_m is None and loaded.near_dv_mps is None
+    assert load_policy(path)[0].near_range_m is None
 
 
 def test_bad_policy_files_name_the_file(tmp_path: Path) -> None:

@@ -52,34 +52,11 @@ def test_near_range_features_read_each_distance_by_hand() -> None:
         DuelingQNetwork((4,), near_range_m=0.0)
 
 
-def test_near_dv_feature_reads_the_speed_difference_by_hand() -> None:
-    net = DuelingQNetwork((1,), near_range_m=10.0, near_dv_mps=2.0)
-    assert net.trunk[0].in_features == 12  # then the 3 near-range features, then dv's
-    with torch.no_grad():
-        for p in net.parameters():
-            p.zero_()
-        net.trunk[0].weight[0, 11] = -1.0  # dv's feature, negated: a leader pulling away
-        net.value.weight.fill_(1.0)
-    # a leader creeping off at 0.5 m/s from a standing ego: dv = -0.5,
-    # Q = relu(-tanh(-0.5 / 2)) = tanh(0.25) = 0.244919; scaled by 20 it would be 0.025
-    raw = np.array([[0, 0.0, 13.9, 4.0, -0.5, 200.0, 0, 200.0]], dtype=np.float32)
-    assert net(torch.from_numpy(raw))[0, 0].item() == pytest.approx(0.244919, abs=1e-6)
-    raw[0, 4] = -8.0  # saturates: tanh(4) = 0.999329
-    assert net(torch.from_numpy(raw))[0, 0].item() == pytest.approx(0.999329, abs=1e-6)
-    raw[0, 4] = 1.0  # closing: relu(-tanh(0.5)) = 0
-    assert net(torch.from_numpy(raw))[0, 0].item() == 0.0
-    with pytest.raises(ValueError, match="near_dv_mps"):
-        DuelingQNetwork((4,), near_dv_mps=-1.0)
-
-
 def test_learner_builds_the_network_the_config_names() -> None:
     assert D3QNLearner(PAPER.replace(hidden_sizes=[4])).q.trunk[0].in_features == 8
     learner = D3QNLearner(PAPER.replace(hidden_sizes=[4], near_range_m=15.0))
     assert learner.q.near_range_m == learner.q_target.near_range_m == 15.0
     assert learner.q.trunk[0].in_features == 11
-    learner = D3QNLearner(PAPER.replace(hidden_sizes=[4], near_dv_mps=2.0))
-    assert learner.q.near_dv_mps == learner.q_target.near_dv_mps == 2.0
-    assert learner.q.trunk[0].in_features == 9
 
 
 def test_soft_and_hard_target_updates() -> None:

@@ -42,13 +42,7 @@ CONFIG_FILE = "config.json"
 POLICY_FILE = "policy.pt"  # a training run's final policy, its card next to it
 # Fields a resumed run must share with its checkpoint; the others (episodes, logging...)
 # may change between runs.
-STRUCTURAL_FIELDS: tuple[str, ...] = (
-    "mode",
-    "hidden_sizes",
-    "near_range_m",
-    "near_dv_mps",
-    "buffer_size",
-)
+STRUCTURAL_FIELDS: tuple[str, ...] = ("mode", "hidden_sizes", "near_range_m", "buffer_size")
 
 
 class CheckpointError(RuntimeError):
@@ -189,7 +183,6 @@ def save_policy(path: Path, network: DuelingQNetwork, card: dict[str, Any]) -> t
         "state_dim": network.state_dim,
         "n_actions": network.n_actions,
         "near_range_m": network.near_range_m,
-        "near_dv_mps": network.near_dv_mps,
         "state_dict": network.state_dict(),
     }
     buf = io.BytesIO()
@@ -223,7 +216,6 @@ def load_policy(path: Path) -> tuple[DuelingQNetwork, dict[str, Any]]:
             payload["state_dim"],
             payload["n_actions"],
             payload.get("near_range_m"),  # absent from files saved before the option
-            payload.get("near_dv_mps"),  # likewise
         )
         net.load_state_dict(payload["state_dict"])
     except (KeyError, RuntimeError, ValueError) as exc:

@@ -78,10 +78,6 @@ class TrainConfig(ConfigModel, ScenarioFields):
     """If set, the network also reads exp(-d / near_range_m) of each of the three distances
     (:class:`~explaindrive.agent.network.DuelingQNetwork`): a fine input near a leader or a
     stop line; ``None``: the 8 scaled components alone (the paper)."""
-    near_dv_mps: PositiveFloat | None = None
-    """If set, the network also reads tanh(dv / near_dv_mps) of the speed difference to the
-    leader (:class:`~explaindrive.agent.network.DuelingQNetwork`): a fine input for a leader
-    creeping off or closing slowly; ``None``: not read."""
     lr: PositiveFloat = 1e-3
     """Adam learning rate (the paper: 1e-3)."""
     lr_final: PositiveFloat | None = None

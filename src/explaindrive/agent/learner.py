@@ -64,11 +64,7 @@ class D3QNLearner:
     def __init__(self, config: TrainConfig, seed: int | None = None) -> None:
         self.config = config
         torch.manual_seed(config.seed if seed is None else seed)
-        self.q = DuelingQNetwork(
-            config.hidden_sizes,
-            near_range_m=config.near_range_m,
-            near_dv_mps=config.near_dv_mps,
-        )
+        self.q = DuelingQNetwork(config.hidden_sizes, near_range_m=config.near_range_m)
         self.q_target = copy.deepcopy(self.q)
         self.q_target.requires_grad_(False)
         self.optimizer = torch.optim.Adam(self.q.parameters(), lr=config.lr)

@@ -31,11 +31,6 @@ class DuelingQNetwork(nn.Module):
     per distance (:data:`DISTANCES`), exp(-d / near_range_m): scaled by the sensor range, a
     metre near a stop line moves the input by 0.005, which a ReLU network resolves poorly;
     the feature moves by about ``1 / near_range_m`` per metre there and fades to 0 far away.
-
-    With ``near_dv_mps`` set, one more feature follows: tanh(dv / near_dv_mps) of the speed
-    difference to the leader. Scaled by 20 m/s, a leader creeping off at 0.5 m/s moves the
-    input by 0.025; the feature moves by about ``1 / near_dv_mps`` per m/s near 0 and
-    saturates at +-1 for large differences.
     """
 
     inv_scale: Tensor
@@ -46,7 +41,6 @@ class DuelingQNetwork(nn.Module):
         state_dim: int = STATE_DIM,
         n_actions: int = N_ACTIONS,
         near_range_m: float | None = None,
-        near_dv_mps: float | None = None,
     ) -> None:
         super().__init__()
         if state_dim != STATE_DIM:
@@ -55,17 +49,13 @@ class DuelingQNetwork(nn.Module):
             raise ValueError(f"hidden_sizes must be positive ints, got {list(hidden_sizes)}")
         if near_range_m is not None and not near_range_m > 0.0:
             raise ValueError(f"near_range_m must be positive, got {near_range_m}")
-        if near_dv_mps is not None and not near_dv_mps > 0.0:
-            raise ValueError(f"near_dv_mps must be positive, got {near_dv_mps}")
         self.hidden_sizes = tuple(int(h) for h in hidden_sizes)
         self.near_range_m = None if near_range_m is None else float(near_range_m)
-        self.near_dv_mps = None if near_dv_mps is None else float(near_dv_mps)
         self.state_dim = state_dim
         self.n_actions = n_actions
         self.register_buffer("inv_scale", torch.from_numpy(1.0 / STATE_SCALE.astype(np.float32)))
         layers: list[nn.Module] = []
         width = state_dim + (0 if near_range_m is None else len(DISTANCES))
-        width += 0 if near_dv_mps is None else 1
         for h in self.hidden_sizes:
             layers += [nn.Linear(width, h), nn.ReLU()]
             width = h
@@ -79,9 +69,6 @@ class DuelingQNetwork(nn.Module):
         if self.near_range_m is not None:
             near = torch.exp(obs[..., list(DISTANCES)] * (-1.0 / self.near_range_m))
             x = torch.cat((x, near), dim=-1)
-        if self.near_dv_mps is not None:
-            fine_dv = torch.tanh(obs[..., S.DV : S.DV + 1] * (1.0 / self.near_dv_mps))
-            x = torch.cat((x, fine_dv), dim=-1)
         features = self.trunk(x)
         return dueling_aggregate(self.value(features), self.advantage(features))
 

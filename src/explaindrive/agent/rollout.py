@@ -266,11 +266,7 @@ class RolloutWorker:
         self.config = config
         self.worker_id = worker_id
         self.env = env_factory()
-        self.net = DuelingQNetwork(
-            config.hidden_sizes,
-            near_range_m=config.near_range_m,
-            near_dv_mps=config.near_dv_mps,
-        )
+        self.net = DuelingQNetwork(config.hidden_sizes, near_range_m=config.near_range_m)
         self.net.requires_grad_(False)
         self.episode: _Running | None = None
 
