@@ -44,9 +44,9 @@ def test_on_the_calibration_pool_stops_are_heard_and_few_other_lines_are_a_stop(
         if e.label not in ("fast", "comfort", "stop") and r.reading == "stop"
     ]
     negatives = sum(e.label not in ("fast", "comfort", "stop") for e in pool)
-    # the calibration chose the STOP threshold there, at most 0.1 % false STOPs: 148 of 160
-    # heard, 1 of 4,029 false (with STOP's path); the three drop-offs inside a plan written
-    # since and held out for calibration ("Drop my dad at the pharmacy first, then take me
-    # home.") are among the 12 missed
-    assert len(stops) > 100 and np.mean(stops) >= 0.92
+    # the calibration chose the STOP threshold there, at most 0.1 % false STOPs: 148 of the
+    # 157 STOP requests heard then (a share of 0.94), 1 of 4,027 false (with STOP's path).
+    # The pool now holds 160: the three drop-offs inside a plan added to it ("Drop my dad at
+    # the pharmacy first, then take me home.") are missed, the 148 are still heard
+    assert len(stops) > 100 and sum(stops) >= 148
     assert negatives > 3000 and len(false_stops) <= 0.001 * negatives
