@@ -24,7 +24,7 @@ LLM-1's negatives (split ``train``) and part of its calibration pool (``calibrat
 EVERYDAY_CHECK = "everyday_check.csv.gz"
 """The external check: chat messages of a public dialogue corpus no model is trained or
 selected on."""
-HELDOUT_CSV = "commands_heldout7.csv"
+HELDOUT_CSV = "commands_heldout8.csv"
 """The test split: written by an author who saw neither the data nor the models, committed
 before any model was run on it, scored once. Its column ``split`` says whether a line had a
 near-copy among the lines a model learns or is calibrated from when it was committed
@@ -36,6 +36,7 @@ FORMER_HELDOUT_CSVS = (
     "commands_heldout4.csv",
     "commands_heldout5.csv",
     "commands_heldout6.csv",
+    "commands_heldout7.csv",
 )
 """Development splits: the previous test splits (each scored once, its errors read since),
 trained on."""
