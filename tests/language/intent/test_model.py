@@ -107,24 +107,23 @@ def test_thresholds_weigh_missed_stops_and_bound_false_commands() -> None:
     assert points[0.56].false_command == 0.0
     assert points[0.56].coverage == pytest.approx(0.5)
     assert "STOP threshold 0.96, command threshold 0.46" in report
-    # two STOP requests at 0.6 and 0.45: up to 0.45 the cost is 0 + 2 false STOPs, at
-    # 0.46-0.50 5 + 2, 0.51-0.60 5 + 1, then 10 + 1 and, from 0.96, 10 + 0
+    # two STOP requests at 0.6 and 0.45 do not move it: below 0.96 a line without a
+    # command would be read as STOP
     rows += [_p(stop=0.6, none=0.4), _p(stop=0.45, none=0.55)]
     labels += ["stop", "stop"]
-    assert choose_thresholds(model, np.array(rows), labels)[0].stop == pytest.approx(0.30)
+    assert choose_thresholds(model, np.array(rows), labels)[0].stop == pytest.approx(0.96)
 
 
-def test_the_stop_threshold_reads_at_most_one_in_a_thousand_lines_as_stop() -> None:
-    # one STOP request at p(stop) 0.45; 3 of 1,000 lines without a command at 0.5.
-    # Costs: up to 0.45, 3 false STOPs; 0.46-0.50, 5 + 3; from 0.51, 5. Least cost is 0.30,
-    # but 3 > 0.1 % of 1,000: of the thresholds with at most 1 false STOP, 0.51 costs least
+def test_the_stop_threshold_reads_no_line_without_a_command_as_stop() -> None:
+    # 3 of 1,000 lines without a command at p(stop) 0.5: 0.50 reads them as STOP, 0.51 none
     negative = np.array([0.5] * 3 + [0.01] * 997)
-    assert stop_threshold(np.array([0.45]), negative) == pytest.approx(0.51)
-    # with 3,000 such lines 3 false STOPs are allowed, and 0.30 is chosen
-    more = np.concatenate([negative, np.full(2000, 0.01)])
-    assert stop_threshold(np.array([0.45]), more) == pytest.approx(0.30)
-    # no threshold of the grid keeps under the cap: the highest
-    assert stop_threshold(np.array([0.45]), np.array([1.0, 1.0])) == pytest.approx(0.99)
+    assert stop_threshold(negative) == pytest.approx(0.51)
+    # a line at exactly 0.51 is read as STOP at 0.51: the next step of the grid
+    assert stop_threshold(np.append(negative, 0.51)) == pytest.approx(0.52)
+    # every line below the grid: its lowest threshold
+    assert stop_threshold(np.full(10, 0.1)) == pytest.approx(0.30)
+    # no threshold of the grid reads none of them: the highest
+    assert stop_threshold(np.array([1.0, 1.0])) == pytest.approx(0.99)
 
 
 @pytest.mark.parametrize(
