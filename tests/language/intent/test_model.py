@@ -83,7 +83,7 @@ def test_the_model_file_round_trips_and_refuses_a_bad_one(tmp_path) -> None:
         IntentModel.load(tmp_path / "missing.npz")
 
 
-def test_thresholds_weigh_missed_stops_and_bound_false_commands() -> None:
+def test_thresholds_read_no_false_stop_and_bound_false_commands() -> None:
     model = _model()
     # 2,000 lines without a command: one at p(stop) 0.95, one at 0.5; 20 with p(fast)
     # 0.55 and 21 with p(fast) 0.45, the most probable reading of their rows

@@ -32,7 +32,7 @@ def test_default_ride_lines(interpreter: EmbeddedIntentInterpreter) -> None:
     assert [r.reading for r in got] == ["fast", "why", "stop", "comfort"]
 
 
-def test_on_the_calibration_pool_stops_are_heard_and_few_other_lines_are_a_stop(
+def test_on_the_calibration_pool_stops_are_heard_and_no_other_line_is_a_stop(
     interpreter: EmbeddedIntentInterpreter,
 ) -> None:
     pool = calibration_pool()
