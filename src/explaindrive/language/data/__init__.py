@@ -21,10 +21,15 @@ LLM-1's training; one line in seven is kept for calibration."""
 EVERYDAY_TRAIN = "everyday_train.csv.gz"
 """Everyday language from corpora public packages ship (``scripts/build_everyday_corpus.py``):
 LLM-1's negatives (split ``train``) and part of its calibration pool (``calibration``)."""
+EVERYDAY_WORDS_CSV = "everyday_driving_words.csv"
+"""The lines of the same everyday corpora that use words of pace, stopping or driving
+(which ``scripts/build_everyday_corpus.py`` leaves out of ``everyday_train.csv.gz``),
+labelled by a reader outside the project as if each were said in the taxi (column
+``label``; most ask for nothing); one line in seven is kept for calibration."""
 EVERYDAY_CHECK = "everyday_check.csv.gz"
 """The external check: chat messages of a public dialogue corpus no model is trained or
 selected on."""
-HELDOUT_CSV = "commands_heldout8.csv"
+HELDOUT_CSV = "commands_heldout9.csv"
 """The test split: written by an author who saw neither the data nor the models, committed
 before any model was run on it, scored once. Its column ``split`` says whether a line had a
 near-copy among the lines a model learns or is calibrated from when it was committed
@@ -37,6 +42,7 @@ FORMER_HELDOUT_CSVS = (
     "commands_heldout5.csv",
     "commands_heldout6.csv",
     "commands_heldout7.csv",
+    "commands_heldout8.csv",
 )
 """Development splits: the previous test splits (each scored once, its errors read since),
 trained on."""
@@ -48,7 +54,14 @@ speech-recognition errors and off-topic remarks with driving words (scored as a 
 once, read since): calibration only."""
 DEVELOPMENT_CSVS = (TEST_CSV, BLIND_CSV)
 """The development splits LLM-1 is calibrated on, never trained on."""
-LABELLED_CSVS = (TRAIN_CSV, WRITTEN_CSV, *FORMER_HELDOUT_CSVS, *DEVELOPMENT_CSVS, HELDOUT_CSV)
+LABELLED_CSVS = (
+    TRAIN_CSV,
+    WRITTEN_CSV,
+    EVERYDAY_WORDS_CSV,
+    *FORMER_HELDOUT_CSVS,
+    *DEVELOPMENT_CSVS,
+    HELDOUT_CSV,
+)
 """Every file of labelled lines (the test split last)."""
 DECISIONS_JSONL = "decisions.jsonl"
 """Labelled state records for the LLM-2 trigger and the LLM-3 explanations."""

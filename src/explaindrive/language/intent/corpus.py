@@ -8,6 +8,9 @@
   stopping words in other senses, questions about the car's behaviour (``why``), answers
   to a confirmation (``yes`` / ``no``), negated requests; one line in seven (by a hash of
   the text) is kept for calibration.
+* Everyday lines with driving words (``everyday_driving_words.csv``): lines of the everyday
+  corpora that use words of pace or stopping, labelled by a reader outside the project;
+  one line in seven is kept for calibration, as for the written lines.
 * Everyday language (``everyday_train.csv.gz``, built by
   ``scripts/build_everyday_corpus.py`` from corpora public packages ship): no command;
   its ``calibration`` split is kept for calibration.
@@ -33,6 +36,7 @@ from explaindrive.language.data import (
     DEVELOPMENT_CSVS,
     EVERYDAY_CHECK,
     EVERYDAY_TRAIN,
+    EVERYDAY_WORDS_CSV,
     FORMER_HELDOUT_CSVS,
     TRAIN_CSV,
     WRITTEN_CSV,
@@ -44,7 +48,7 @@ RESERVE = "reserve"
 NEAR_COPY = 0.8
 """Character similarity (difflib's ratio, either way round) from which a line counts as a
 near-copy of another: no line near the test split is trained or calibrated on."""
-WRITTEN_HOLDOUT = 7  # one written line in this many is kept for calibration
+WRITTEN_HOLDOUT = 7  # one written (or labelled everyday) line in this many is calibrated on
 SPLIT_ONLY_KINDS = frozenset({"why", "answer"})
 """Kinds of line a test split labels ``none`` (no command) that LLM-1 reads as ``why``,
 ``yes`` or ``no``: the former test splits' lines of these kinds are not trained on, since
@@ -106,7 +110,8 @@ def training_pool() -> tuple[list[Example], list[Example]]:
         labelled += [
             e for e, row in _labelled(data_path(name)) if row.get("kind") not in SPLIT_ONLY_KINDS
         ]
-    labelled += [e for e, _ in _labelled(data_path(WRITTEN_CSV)) if not _held_out(e.text)]
+    for name in (WRITTEN_CSV, EVERYDAY_WORDS_CSV):
+        labelled += [e for e, _ in _labelled(data_path(name)) if not _held_out(e.text)]
     everyday = [
         Example(row["text"], "none", f"{EVERYDAY_TRAIN}:{row['source']}")
         for row in read_lines(data_path(EVERYDAY_TRAIN))
@@ -121,7 +126,8 @@ def calibration_pool() -> list[Example]:
     labelled, everyday = training_pool()
     trained = {e.text.lower() for e in labelled} | {e.text.lower() for e in everyday}
     pool = [e for e, row in _labelled(data_path(TRAIN_CSV)) if row.get("split") == RESERVE]
-    pool += [e for e, _ in _labelled(data_path(WRITTEN_CSV)) if _held_out(e.text)]
+    for name in (WRITTEN_CSV, EVERYDAY_WORDS_CSV):
+        pool += [e for e, _ in _labelled(data_path(name)) if _held_out(e.text)]
     for name in DEVELOPMENT_CSVS:
         pool += [e for e, _ in _labelled(data_path(name))]
     pool += [
