@@ -48,7 +48,9 @@ RESERVE = "reserve"
 NEAR_COPY = 0.8
 """Character similarity (difflib's ratio, either way round) from which a line counts as a
 near-copy of another: no line near the test split is trained or calibrated on."""
-WRITTEN_HOLDOUT = 7  # one written (or labelled everyday) line in this many is calibrated on
+HASH_SPLIT_CSVS = (WRITTEN_CSV, EVERYDAY_WORDS_CSV)
+"""The labelled files split between training and calibration by a hash of each line's text."""
+HASH_HOLDOUT = 7  # one line of those files in this many is kept for calibration
 SPLIT_ONLY_KINDS = frozenset({"why", "answer"})
 """Kinds of line a test split labels ``none`` (no command) that LLM-1 reads as ``why``,
 ``yes`` or ``no``: the former test splits' lines of these kinds are not trained on, since
@@ -100,7 +102,7 @@ def _labelled(path: Path) -> list[tuple[Example, dict[str, str]]]:
 
 def _held_out(text: str) -> bool:
     digest = hashlib.sha256(text.lower().encode("utf-8")).hexdigest()
-    return int(digest, 16) % WRITTEN_HOLDOUT == 0
+    return int(digest, 16) % HASH_HOLDOUT == 0
 
 
 def training_pool() -> tuple[list[Example], list[Example]]:
@@ -110,7 +112,7 @@ def training_pool() -> tuple[list[Example], list[Example]]:
         labelled += [
             e for e, row in _labelled(data_path(name)) if row.get("kind") not in SPLIT_ONLY_KINDS
         ]
-    for name in (WRITTEN_CSV, EVERYDAY_WORDS_CSV):
+    for name in HASH_SPLIT_CSVS:
         labelled += [e for e, _ in _labelled(data_path(name)) if not _held_out(e.text)]
     everyday = [
         Example(row["text"], "none", f"{EVERYDAY_TRAIN}:{row['source']}")
@@ -126,7 +128,7 @@ def calibration_pool() -> list[Example]:
     labelled, everyday = training_pool()
     trained = {e.text.lower() for e in labelled} | {e.text.lower() for e in everyday}
     pool = [e for e, row in _labelled(data_path(TRAIN_CSV)) if row.get("split") == RESERVE]
-    for name in (WRITTEN_CSV, EVERYDAY_WORDS_CSV):
+    for name in HASH_SPLIT_CSVS:
         pool += [e for e, _ in _labelled(data_path(name)) if _held_out(e.text)]
     for name in DEVELOPMENT_CSVS:
         pool += [e for e, _ in _labelled(data_path(name))]
