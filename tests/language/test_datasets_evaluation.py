@@ -7,6 +7,7 @@ from difflib import SequenceMatcher
 
 import pytest
 
+from explaindrive.commands import Command
 from explaindrive.language.backends.embedded import RuleDecider, TemplateExplainer
 from explaindrive.language.config import LanguageConfig
 from explaindrive.language.data import (
@@ -18,7 +19,12 @@ from explaindrive.language.data import (
     TRAIN_CSV,
     data_path,
 )
-from explaindrive.language.evaluation import evaluate_decisions, intent_metrics
+from explaindrive.language.evaluation import (
+    evaluate_decisions,
+    evaluate_everyday,
+    evaluate_intents,
+    intent_metrics,
+)
 from explaindrive.language.explanation.datasets import load_decisions
 from explaindrive.language.explanation.explainer import Factor, present_factors
 from explaindrive.language.intent.corpus import near_copies, read_lines
@@ -29,6 +35,11 @@ from explaindrive.language.intent.datasets import (
     CommandExample,
     load_commands,
     training_splits,
+)
+from explaindrive.language.intent.interpreter import (
+    IntentInterpreter,
+    IntentResult,
+    format_confirmation,
 )
 
 NEAR_COPY = 0.8  # character similarity (difflib ratio) from which a text counts as a near-copy
@@ -196,6 +207,41 @@ def test_intent_metrics_by_hand() -> None:
     assert m["template_compliance"] == pytest.approx(5 / 6, abs=1e-4)
     assert m["none_rejection"] == 0.5
     assert m["confusion"]["matrix"][2] == [0, 0, 1, 1]
+
+
+class _Scripted(IntentInterpreter):
+    """Reads a line as the command it names, ``ask`` as a STOP asked about."""
+
+    def interpret(self, text: str) -> IntentResult:
+        if text.startswith("ask"):
+            q = format_confirmation(Command.STOP)
+            return IntentResult(None, q, "x", False, 0.0, {}, reading="none", ask=Command.STOP)
+        cmd = Command.parse(text.split()[0]) if text.split()[0] != "none" else None
+        q = format_confirmation(cmd) if cmd is not None else "rephrase"
+        return IntentResult(cmd, q, "x", False, 0.0, {}, reading=cmd.label if cmd else "none")
+
+
+def test_lines_asked_about_are_counted_apart_from_the_commands() -> None:
+    rows = [
+        CommandExample("stop now", "stop"),
+        CommandExample("ask 1", "stop"),
+        CommandExample("none 1", "stop"),
+        CommandExample("stop 2", "stop"),
+        CommandExample("ask 2", "none"),
+        CommandExample("none 2", "none"),
+        CommandExample("fast", "fast"),
+    ]
+    report = evaluate_intents(_Scripted(), rows)
+    # STOP read for 2 of 4 STOP requests; read or asked about for 3 of 4
+    assert report["per_class"]["stop"]["recall"] == 0.5
+    assert report["stop_heard"] == 0.75
+    assert report["asked_stop"] == {"stop": 1, "none": 1}
+    assert report["none_rejection"] == 1.0  # an ask gives no command
+    everyday = evaluate_everyday(_Scripted(), ["none a", "ask b", "fast c", "none d"])
+    assert (everyday["left_without_command"], everyday["left_alone"]) == (0.75, 0.5)
+    assert everyday["asked_stop"] == 1 and everyday["asked"] == [
+        {"text": "ask b", "command": "stop"}
+    ]
 
 
 def test_decisions_on_shipped_set_meet_targets() -> None:

@@ -68,7 +68,8 @@ class ScriptedController:
 
 class KeywordInterpreter(IntentInterpreter):
     """Maps keywords to commands, ``yes`` / ``no`` alone to answers, a line starting with
-    ``why`` to a question; ``slow`` in the text makes it sleep, ``crash`` raise."""
+    ``why`` to a question, a line with ``maybe out`` to a STOP asked about; ``slow`` in the
+    text makes it sleep, ``crash`` raise."""
 
     name = "fake"
     words: ClassVar[dict[str, Command]] = {
@@ -90,6 +91,11 @@ class KeywordInterpreter(IntentInterpreter):
         if text.strip().lower() in ("yes", "no"):
             answer = text.strip().lower()
             return IntentResult(None, "Rephrase?", self.name, False, 0.0, {}, reading=answer)
+        if "maybe out" in text.lower():
+            question = format_confirmation(Command.STOP)
+            return IntentResult(
+                None, question, self.name, False, 0.0, {}, reading="none", ask=Command.STOP
+            )
         intent = next((c for w, c in self.words.items() if w in text.lower()), None)
         question = format_confirmation(intent) if intent is not None else "Could you rephrase?"
         reading = intent.label if intent is not None else "none"

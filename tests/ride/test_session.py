@@ -178,6 +178,25 @@ def test_stop_without_confirm_and_auto_confirm():
     session.close()
 
 
+def test_a_stop_asked_about_waits_for_the_passengers_yes():
+    # even where a STOP read is applied at once, a STOP asked about waits for the answer
+    session = make_session(stop_without_confirm=True, max_steps=30)
+    session.start()
+    session.say("maybe out here")
+    for _ in range(3):
+        session.step()
+    assert session.command is Command.FAST and session.pending_confirmation is not None
+    assert session.pending_confirmation.question == "You want me to stop, is this correct?"
+    assert session.counts.asked_stop == 1
+    session.say("yes")
+    session.step()
+    session.step()
+    assert session.records[-1].command == "stop" and session.pending_confirmation is None
+    (interpretation,) = events(session, "interpretation")[:1]
+    assert (interpretation["intent"], interpretation["ask"]) == (None, "stop")
+    session.close()
+
+
 def test_explanations_repeat_only_on_a_new_reason_or_after_cooldown(tmp_path):
     session = make_session(explanation_cooldown_s=1000.0, max_steps=150)
     run_ride(session, [line(0, "hurry", "yes")], tmp_path)

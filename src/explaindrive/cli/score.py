@@ -114,6 +114,13 @@ def _print_intents(report: dict[str, Any], title: str) -> None:
         f"negated stops read as STOP {report['negated_stops_read_as_stop']}",
         highlight=False,
     )
+    asked = report["asked_stop"]
+    console.print(
+        f"asked whether to stop: {sum(asked.values())} lines "
+        f"({', '.join(f'{k} {v}' for k, v in sorted(asked.items())) or 'none'}); "
+        f"STOP requests read as STOP or asked about {_fmt(report['stop_heard'])}",
+        highlight=False,
+    )
     if "trust_sweep" in report:
         sweep = Table(title="the same replies with another trust_embedded_from")
         for col in ("trust_embedded_from", "accuracy", "off-topic left", "STOP recall"):
@@ -158,11 +165,14 @@ def everyday_command(
     console.print(
         f"LLM-1 on {data.name} ({stack.backend}): {report['n']} lines, "
         f"{report['left_without_command']:.4f} left without a command; given fast "
-        f"{c['fast']}, comfort {c['comfort']}, STOP {c['stop']}",
+        f"{c['fast']}, comfort {c['comfort']}, STOP {c['stop']}; asked whether to stop "
+        f"{report['asked_stop']} ({report['left_alone']:.4f} left alone)",
         highlight=False,
     )
     for g in report["given"][:20]:
         console.print(f"  {g['command']:7s} {g['text'][:90]}", highlight=False)
+    for g in report["asked"][:10]:
+        console.print(f"  asked   {g['text'][:90]}", highlight=False)
     _write(out, report)
 
 

@@ -53,6 +53,10 @@ class EmbeddedConfig(LaxModel):
     stop_threshold: float | None = Field(default=None, ge=0.0, le=1.0)
     """A STOP reading needs at least this probability; ``None`` = the value stored with the
     model."""
+    ask_stop: bool = True
+    """Ask whether to stop when STOP is the most probable reading but short of its
+    threshold (from the model's stored ask threshold); ``False``: leave such a line without
+    a command."""
     stop_path: bool = True
     """Read STOP's explicit phrases (``pull over``, ``let me out``...) as STOP unless the
     model is sure of another reading (:mod:`explaindrive.language.intent.stop_path`)."""

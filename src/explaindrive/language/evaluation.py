@@ -13,7 +13,7 @@ from sklearn.metrics import (
     precision_recall_fscore_support,
 )
 
-from explaindrive.commands import COMMAND_LABELS
+from explaindrive.commands import COMMAND_LABELS, Command
 from explaindrive.language.explanation.datasets import LabelledRecord
 from explaindrive.language.explanation.decision import ExplanationDecider
 from explaindrive.language.explanation.explainer import Explainer, check_grounding, present_factors
@@ -109,6 +109,9 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
     ``vetoed`` (read, but overruled by a sure embedded reading) and ``not_asked`` (the
     embedded STOP lane, or an empty line). ``by_kind`` gives [correct, total] per kind;
     ``negated_stops_read_as_stop`` counts the rows of kind ``negated_stop`` read as STOP.
+    ``asked_stop`` counts, per label, the rows given no command whose reading the car asks
+    about ("You want me to stop...?"), and ``stop_heard`` is the share of STOP rows read as
+    STOP or asked about (the recall once the passenger's yes is counted).
     With a remote model, ``trust_sweep`` gives the figures each ``trust_embedded_from`` of
     :data:`~explaindrive.language.intent.agreement.TRUST_GRID` would have given on the same
     replies (:func:`~explaindrive.language.intent.agreement.trust_sweep`).
@@ -133,10 +136,25 @@ def evaluate_intents(interpreter: IntentInterpreter, rows: list[CommandExample])
             p == "stop" for p, row in zip(preds, rows, strict=True) if row.kind == "negated_stop"
         ),
         latency=_percentiles([r.latency_s for r in results]),
+        **_asked(rows, results),
     )
     if any(x.readable for x in both):
         out["trust_sweep"] = trust_sweep(both)
     return out
+
+
+def _asked(rows: list[CommandExample], results: list[IntentResult]) -> dict[str, Any]:
+    """``asked_stop`` (per label) and ``stop_heard`` (see :func:`evaluate_intents`)."""
+    asked: dict[str, int] = {}
+    for row, r in zip(rows, results, strict=True):
+        if r.intent is None and r.ask is Command.STOP:
+            asked[row.label] = asked.get(row.label, 0) + 1
+    stops = [r for row, r in zip(rows, results, strict=True) if row.label == "stop"]
+    heard = sum(r.intent is Command.STOP or r.ask is Command.STOP for r in stops)
+    return {
+        "asked_stop": asked,
+        "stop_heard": round(heard / len(stops), 4) if stops else None,
+    }
 
 
 def _reply_counts(results: list[IntentResult]) -> dict[str, int]:
@@ -189,25 +207,34 @@ def evaluate_everyday(interpreter: IntentInterpreter, texts: list[str]) -> dict[
     """LLM-1 on everyday lines that ask for no command (the external check).
 
     Returns:
-        ``n``; ``left_without_command`` (share); ``commands`` (count per command given);
-        ``readings`` (count per reading); ``given`` (every line given a command, with it).
+        ``n``; ``left_without_command`` (share); ``left_alone`` (share given no command
+        and not asked about either); ``commands`` (count per command given);
+        ``asked_stop`` (count of lines the car asks whether to stop); ``readings`` (count
+        per reading); ``given`` (every line given a command, with it); ``asked`` (every
+        line asked about).
     """
     results = [interpreter.interpret(t) for t in texts]
     commands = {c: 0 for c in COMMAND_LABELS}
     readings: dict[str, int] = {}
     given = []
+    asked = []
     for text, r in zip(texts, results, strict=True):
         readings[r.reading or "-"] = readings.get(r.reading or "-", 0) + 1
         if r.intent is not None:
             commands[r.intent.label] += 1
             given.append({"text": text, "command": r.intent.label})
+        elif r.ask is not None:
+            asked.append({"text": text, "command": r.ask.label})
     n = len(texts)
     return {
         "n": n,
         "left_without_command": round(1.0 - len(given) / n, 4) if n else None,
+        "left_alone": round(1.0 - (len(given) + len(asked)) / n, 4) if n else None,
         "commands": commands,
+        "asked_stop": len(asked),
         "readings": readings,
         "given": given,
+        "asked": asked,
         "latency": _percentiles([r.latency_s for r in results]),
     }
 

@@ -105,6 +105,8 @@ class RideCounts:
     answers: int = 0
     questions: int = 0
     understood: int = 0
+    asked_stop: int = 0
+    """Lines the car asked about ("You want me to stop...?") without having read a STOP."""
     rephrase: int = 0
     confirmations: int = 0
     cancellations: int = 0

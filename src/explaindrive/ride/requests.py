@@ -155,7 +155,8 @@ class PassengerRequests:
             self.counts.questions += 1
             self.on_question(req.id)
             return
-        if result.intent is None:
+        intent = result.intent if result.intent is not None else result.ask
+        if intent is None:
             self.counts.rephrase += 1
             return
         if req.id < self._newest_read:
@@ -164,8 +165,10 @@ class PassengerRequests:
             self._note({"type": EventType.SUPERSEDED, "id": req.id, "by": self._newest_read})
             return
         self.counts.understood += 1
+        self.counts.asked_stop += int(result.intent is None)
         self._newest_read = req.id
-        req.intent, req.question = result.intent, result.confirmation
+        # a STOP asked about (not read) waits for a yes: stop_without_confirm is for STOPs read
+        req.intent, req.question = intent, result.confirmation
         if result.intent is Command.STOP and self.config.stop_without_confirm:
             self._resolve(req, True, source="stop-without-confirm")
         elif req.confirm is not None:

@@ -26,6 +26,7 @@ from explaindrive.language.backends.openai import (
 from explaindrive.language.config import OpenAIConfig
 from explaindrive.language.explanation.decision import Factor
 from explaindrive.language.explanation.summary import StateRecord
+from explaindrive.language.intent.interpreter import IntentResult, format_confirmation
 
 if TYPE_CHECKING:
     from tests.language.conftest import ScriptedOpenAI
@@ -183,3 +184,36 @@ def test_grammar_is_sent_to_llm1_and_llm2_only_when_asked(openai_server) -> None
     assert (
         '"drive more carefully"' in INTENT_GRAMMAR and '"NOT A DRIVING REQUEST"' in INTENT_GRAMMAR
     )
+
+
+class _AskingReader(EmbeddedIntentInterpreter):
+    """An embedded reader that asks whether to stop about every line (STOP most probable,
+    short of its threshold), without loading a model."""
+
+    def __init__(self) -> None:
+        pass
+
+    def interpret(self, text: str) -> IntentResult:
+        scores = {"fast": 0.01, "comfort": 0.01, "stop": 0.6, "none": 0.38}
+        q = format_confirmation(Command.STOP)
+        return IntentResult(
+            None, q, "embedded", False, 0.0, scores, reading="none", ask=Command.STOP
+        )
+
+
+@pytest.mark.parametrize(
+    ("reply", "intent", "ask"),
+    [
+        ("NOT A DRIVING REQUEST", None, Command.STOP),  # no command counts: the car still asks
+        ("You want me to stop, is this correct?", Command.STOP, None),  # the remote STOP
+        ("You want me to drive faster, is this correct?", Command.FAST, None),
+    ],
+)
+def test_a_stop_the_embedded_reader_asks_about_is_asked_unless_a_command_counts(
+    openai_server: ScriptedOpenAI, reply: str, intent: Command | None, ask: Command | None
+) -> None:
+    openai_server.script = [("ok", reply)]
+    r = OpenAIIntentInterpreter(client(openai_server), _AskingReader()).interpret("Out.")
+    assert (r.intent, r.ask) == (intent, ask)
+    shown = intent if intent is not None else ask  # Command.FAST is 0: not "or"
+    assert shown is not None and r.confirmation == format_confirmation(shown)

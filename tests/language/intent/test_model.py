@@ -6,7 +6,12 @@ import numpy as np
 import pytest
 
 from explaindrive.language.intent.adapter import AdapterSpec, merge
-from explaindrive.language.intent.calibration import choose_thresholds, curve, stop_threshold
+from explaindrive.language.intent.calibration import (
+    ask_stop_threshold,
+    choose_thresholds,
+    curve,
+    stop_threshold,
+)
 from explaindrive.language.intent.model import READINGS, IntentModel, Thresholds
 from explaindrive.language.intent.stop_path import names_stop
 
@@ -69,11 +74,35 @@ def test_decide_gives_a_command_only_above_its_threshold(
     assert r.command == (reading if reading in ("fast", "comfort", "stop") else None)
 
 
+@pytest.mark.parametrize(
+    ("probs", "ask"),
+    [
+        ({"stop": 0.69, "none": 0.31}, True),  # most probable, short of 0.7, within the band
+        ({"stop": 0.5, "none": 0.3, "fast": 0.2}, True),  # at the band's floor
+        ({"stop": 0.49, "none": 0.3, "fast": 0.21}, False),  # below it: left alone
+        ({"stop": 0.45, "none": 0.55}, False),  # not the most probable reading
+        ({"stop": 0.7, "none": 0.3}, False),  # read as STOP, not asked about
+    ],
+)
+def test_a_stop_short_of_its_threshold_is_asked_about_within_the_band(
+    probs: dict[str, float], ask: bool
+) -> None:
+    r = _model(Thresholds(0.6, 0.7, 0.5)).decide(_p(**probs))
+    assert r.ask_stop is ask
+    assert r.command == ("stop" if probs["stop"] >= 0.7 else None)
+    # without a band nothing is asked about
+    assert not _model().decide(_p(**probs)).ask_stop
+
+
 def test_the_model_file_round_trips_and_refuses_a_bad_one(tmp_path) -> None:
     model = _model()
     model.save(tmp_path / "m.npz")
     back = IntentModel.load(tmp_path / "m.npz")
     assert back.thresholds == model.thresholds and back.spec == model.spec
+    assert back.thresholds.ask_stop is None  # a file without the band: none
+    banded = _model(Thresholds(0.6, 0.9, 0.55))
+    banded.save(tmp_path / "band.npz")
+    assert IntentModel.load(tmp_path / "band.npz").thresholds == Thresholds(0.6, 0.9, 0.55)
     np.testing.assert_array_equal(back.adapters[LAYER][0], model.adapters[LAYER][0])
     assert back.digest() == model.digest()
     (tmp_path / "bad.npz").write_bytes(b"not a zip")
@@ -106,7 +135,11 @@ def test_thresholds_read_no_false_stop_and_bound_false_commands() -> None:
     assert points[0.46].risk == pytest.approx(20 / 22)  # 20 of the 22 given are wrong
     assert points[0.56].false_command == 0.0
     assert points[0.56].coverage == pytest.approx(0.5)
-    assert "STOP threshold 0.96, command threshold 0.46" in report
+    # the two lines most probably STOP below 0.96 (0.95, and 0.5 tied with none) are 0.1 %
+    # of the lines without a command, within the 0.5 % asked about: asked from the grid's
+    # lowest threshold
+    assert t.ask_stop == pytest.approx(0.30)
+    assert "STOP threshold 0.96, asked about from 0.30, command threshold 0.46" in report
     # two STOP requests at 0.6 and 0.45 do not move it: below 0.96 a line without a
     # command would be read as STOP
     rows += [_p(stop=0.6, none=0.4), _p(stop=0.45, none=0.55)]
@@ -124,6 +157,23 @@ def test_the_stop_threshold_reads_no_line_without_a_command_as_stop() -> None:
     assert stop_threshold(np.full(10, 0.1)) == pytest.approx(0.30)
     # no threshold of the grid reads none of them: the highest
     assert stop_threshold(np.array([1.0, 1.0])) == pytest.approx(0.99)
+
+
+def test_the_ask_band_asks_about_at_most_half_a_percent_of_lines_without_a_command() -> None:
+    # 1,000 lines without a command: 6 most probably STOP at 0.6, 4 at 0.8, one at p(stop)
+    # 0.45 whose most probable reading is why; STOP's threshold 0.9
+    rows = [_p(none=1.0)] * 989 + [_p(stop=0.6, none=0.4)] * 6 + [_p(stop=0.8, none=0.2)] * 4
+    rows.append(_p(stop=0.45, why=0.55))
+    negative = np.ones(len(rows), bool)
+    # up to 0.60 ten are asked about (1.0 % > 0.5 %); from 0.61 four (0.4 %)
+    assert ask_stop_threshold(np.array(rows), negative, 0.9) == pytest.approx(0.61)
+    # a STOP request at 0.6 is not a line without a command: it does not count
+    rows.append(_p(stop=0.6, none=0.4))
+    negative = np.append(negative, False)
+    assert ask_stop_threshold(np.array(rows), negative, 0.9) == pytest.approx(0.61)
+    # six at 0.89 (0.6 %) under a threshold of 0.9: no band (the STOP threshold itself)
+    rows = [_p(none=1.0)] * 994 + [_p(stop=0.89, none=0.11)] * 6
+    assert ask_stop_threshold(np.array(rows), np.ones(1000, bool), 0.9) == pytest.approx(0.9)
 
 
 @pytest.mark.parametrize(

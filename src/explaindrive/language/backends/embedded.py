@@ -55,6 +55,7 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
             self.config.command_threshold,
             self.config.stop_threshold,
             self.config.stop_path,
+            self.config.ask_stop,
         )
 
     def load(self) -> None:
@@ -65,7 +66,8 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
         """Read ``text``; a line that asks for no command gets a request to rephrase.
 
         The result's ``reading`` says what the line is when it is not a command: ``why``
-        (a question about the car's behaviour), ``yes`` / ``no`` (an answer), ``none``.
+        (a question about the car's behaviour), ``yes`` / ``no`` (an answer), ``none``; its
+        ``ask`` is STOP when the car asks whether to stop (STOP most probable but unsure).
         """
         t0 = time.perf_counter()
         if not text or not text.strip():
@@ -74,7 +76,8 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
             )
         (reading,) = self.reader.read([text])
         intent = Command.parse(reading.command) if reading.command is not None else None
-        confirmation = reply_to(intent, reading.reading)
+        ask = Command.STOP if reading.ask_stop else None
+        confirmation = reply_to(intent, reading.reading, ask)
         log.debug("embedded reading %s for %r (%s)", reading.reading, text, reading.scores())
         return IntentResult(
             intent,
@@ -84,6 +87,7 @@ class EmbeddedIntentInterpreter(IntentInterpreter):
             time.perf_counter() - t0,
             command_scores(reading),
             reading=reading.reading,
+            ask=ask,
         )
 
 

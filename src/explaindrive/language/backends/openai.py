@@ -233,7 +233,8 @@ class OpenAIIntentInterpreter(IntentInterpreter):
         are reconciled (:func:`~explaindrive.language.intent.agreement.reconcile`). On any
         failure, the deadline and an unreadable reply included, the embedded reading
         stands in (``fallback=True``). The confirmation is always the template of the
-        command that counts, never the model's text.
+        command that counts, never the model's text; when no command counts and the
+        embedded reader asked whether to stop, the car still asks.
         """
         t0 = time.perf_counter()
         local = self.fallback.interpret(text)
@@ -269,9 +270,10 @@ class OpenAIIntentInterpreter(IntentInterpreter):
         if verdict.source != "both":
             log.info("intent readings differ for %r: %s (%s)", text, verdict.intent, verdict.rule)
         own = verdict.source == "embedded"
+        ask = local.ask if verdict.intent is None else None
         return IntentResult(
             verdict.intent,
-            reply_to(verdict.intent, _reading(verdict.intent, local.reading)),
+            reply_to(verdict.intent, _reading(verdict.intent, local.reading), ask),
             NAME,
             False,
             time.perf_counter() - t0,
@@ -281,6 +283,7 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             raw_reply=raw,
             readings=(local.intent, local_p, reading.command),
             reading=_reading(verdict.intent, local.reading),
+            ask=ask,
         )
 
 

@@ -57,6 +57,9 @@ class IntentResult:
         reading: what the embedded model made of the line: a command's label, ``why`` (a
             question about the car's behaviour), ``yes`` / ``no`` (an answer to a
             confirmation) or ``none``; ``None`` when no embedded reading was made.
+        ask: a command the car asks about without having read it (STOP, most probable but
+            short of its threshold): ``intent`` is ``None``, ``confirmation`` asks, and the
+            passenger's yes gives the command.
     """
 
     intent: Command | None
@@ -72,6 +75,7 @@ class IntentResult:
     raw_reply: str | None = None
     readings: tuple[Command | None, float, Command | None] | None = None
     reading: str | None = None
+    ask: Command | None = None
 
     def to_json(self) -> dict[str, object]:
         """The CLI's JSON shape."""
@@ -84,6 +88,7 @@ class IntentResult:
             "rule": self.rule,
             "overruled": self.overruled,
             "reading": self.reading,
+            "ask": self.ask.label if self.ask is not None else None,
         }
 
 
@@ -102,11 +107,13 @@ def format_confirmation(command: Command) -> str:
     return CONFIRMATION_TEMPLATE.format(action=ACTION_PHRASES[command])
 
 
-def reply_to(command: Command | None, reading: str | None) -> str:
-    """What the car says to a line: the confirmation question for a command, a promise to
-    explain for a question about its behaviour, else a request to rephrase."""
-    if command is not None:
-        return format_confirmation(command)
+def reply_to(command: Command | None, reading: str | None, ask: Command | None = None) -> str:
+    """What the car says to a line: the confirmation question for a command (or for the
+    command it asks about), a promise to explain for a question about its behaviour, else a
+    request to rephrase."""
+    asked = command if command is not None else ask
+    if asked is not None:
+        return format_confirmation(asked)
     return WHY_MESSAGE if reading == "why" else REPHRASE_MESSAGE
 
 

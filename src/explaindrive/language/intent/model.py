@@ -9,7 +9,9 @@ about the driving), ``why`` (a question about what the car is doing), and ``yes`
 The model is open-set by its decision rule (:meth:`IntentModel.decide`): a command is given
 only when its probability reaches a threshold chosen on a calibration pool of everyday
 language and development requests; below it the line is left without a command. STOP has a
-threshold of its own.
+threshold of its own, and below it a band where the car asks back: a line the model reads as
+STOP most likely, but not surely, is given no command; the car asks whether to stop, and the
+passenger's yes stops it.
 """
 
 from __future__ import annotations
@@ -56,10 +58,13 @@ class Thresholds:
     Attributes:
         command: a fast or comfort reading needs at least this probability.
         stop: a STOP reading needs at least this probability.
+        ask_stop: a line whose most probable reading is STOP, at least this probable but
+            short of ``stop``, is asked about (:attr:`Reading.ask_stop`); ``None``: never.
     """
 
     command: float
     stop: float
+    ask_stop: float | None = None
 
 
 @dataclass(frozen=True)
@@ -71,11 +76,14 @@ class Reading:
             threshold (``abstained``).
         p: the probability of each reading, in :data:`READINGS` order.
         abstained: the most probable reading was a command below its threshold.
+        ask_stop: the most probable reading was STOP, short of its threshold but within the
+            band where the car asks whether to stop (:attr:`Thresholds.ask_stop`).
     """
 
     reading: str
     p: NDArray[np.float64]
     abstained: bool = False
+    ask_stop: bool = False
 
     @property
     def command(self) -> str | None:
@@ -119,14 +127,18 @@ class IntentModel:
         """The reading of one probability row.
 
         STOP when its probability reaches the STOP threshold; else the most probable
-        reading, but a command below the command threshold leaves the line without one.
+        reading, but a command below the command threshold leaves the line without one (a
+        STOP within the ask band is asked about).
         """
         t = thresholds or self.thresholds
         p = np.asarray(p, dtype=np.float64)
         if p[STOP] >= t.stop:
             return Reading("stop", p)
         best = int(np.argmax(p))
-        if best == STOP or (best < N_COMMANDS and p[best] < t.command):
+        if best == STOP:
+            ask = t.ask_stop is not None and bool(p[STOP] >= t.ask_stop)
+            return Reading("none", p, abstained=True, ask_stop=ask)
+        if best < N_COMMANDS and p[best] < t.command:
             return Reading("none", p, abstained=True)
         return Reading(READINGS[best], p)
 
@@ -136,6 +148,8 @@ class IntentModel:
         for i, (_, (a, b)) in enumerate(sorted(self.adapters.items())):
             arrays[f"a{i}"] = a.astype(np.float16)
             arrays[f"b{i}"] = b.astype(np.float16)
+        if self.thresholds.ask_stop is not None:
+            arrays["stop_ask_threshold"] = self.thresholds.ask_stop
         np.savez_compressed(
             path,
             layers=np.array(sorted(self.adapters)),
@@ -178,7 +192,9 @@ class IntentModel:
                     head_w=np.asarray(z["head_w"], np.float32),
                     head_b=np.asarray(z["head_b"], np.float32),
                     thresholds=Thresholds(
-                        float(z["command_threshold"]), float(z["stop_threshold"])
+                        float(z["command_threshold"]),
+                        float(z["stop_threshold"]),
+                        float(z["stop_ask_threshold"]) if "stop_ask_threshold" in z else None,
                     ),
                     base_sha256=str(z["base_sha256"]),
                 )

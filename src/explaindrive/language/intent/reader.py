@@ -34,6 +34,7 @@ class LineReader:
         command_threshold: float | None = None,
         stop_threshold: float | None = None,
         stop_path: bool = True,
+        ask_stop: bool = True,
     ) -> None:
         """Args:
         model_path: an intent model file; ``None`` = the shipped one.
@@ -44,6 +45,8 @@ class LineReader:
         stop_threshold: replaces the model's own STOP threshold.
         stop_path: read :data:`~explaindrive.language.intent.stop_path.STOP_PHRASES` as
             STOP unless the model is sure of another reading.
+        ask_stop: keep the model's band below the STOP threshold where the car asks
+            whether to stop (:attr:`~explaindrive.language.intent.model.Thresholds.ask_stop`).
 
         Raises:
             FileNotFoundError, ValueError: for a missing or invalid model file.
@@ -53,6 +56,7 @@ class LineReader:
         self.thresholds = Thresholds(
             own.command if command_threshold is None else command_threshold,
             own.stop if stop_threshold is None else stop_threshold,
+            own.ask_stop if ask_stop else None,
         )
         self.stop_path = stop_path
         self._base_dir = base_dir
