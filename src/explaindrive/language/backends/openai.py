@@ -258,18 +258,20 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             error = _err(exc, self.client)
             log.warning("openai intent failed, using embedded: %s", error)
             return _as_fallback(local, t0, error, raw)
+        return self._settle(text, local, reading.command, raw, t0)
+
+    def _settle(
+        self, text: str, local: IntentResult, remote: Command | None, raw: str, t0: float
+    ) -> IntentResult:
+        """The result once the embedded reading ``local`` and the remote reading ``remote``
+        (from the reply ``raw``) are reconciled."""
         label = local.intent.label if local.intent is not None else "none"
         local_p = local.scores.get(label, 0.0)
         verdict = reconcile(
-            local.intent,
-            local_p,
-            reading.command,
-            NAME,
-            self.client.config.trust_embedded_from,
+            local.intent, local_p, remote, NAME, self.client.config.trust_embedded_from
         )
         if verdict.source != "both":
             log.info("intent readings differ for %r: %s (%s)", text, verdict.intent, verdict.rule)
-        own = verdict.source == "embedded"
         ask = local.ask if verdict.intent is None else None
         return IntentResult(
             verdict.intent,
@@ -279,9 +281,9 @@ class OpenAIIntentInterpreter(IntentInterpreter):
             time.perf_counter() - t0,
             local.scores,
             rule=verdict.rule,
-            overruled=own,
+            overruled=verdict.source == "embedded",
             raw_reply=raw,
-            readings=(local.intent, local_p, reading.command),
+            readings=(local.intent, local_p, remote),
             reading=_reading(verdict.intent, local.reading),
             ask=ask,
         )
