@@ -57,6 +57,8 @@ def interpret_command(
     intent = out["intent"] or "none"
     if result.intent is None and result.reading not in (None, "none"):
         intent = f"none (reading: {result.reading})"  # a why question or a yes / no answer
+    if result.ask is not None:
+        intent = f"none (asks whether to {result.ask.label})"  # STOP most probable, unsure
     note = " [yellow](fallback)[/]" if result.fallback else ""
     note += " [dim](offline STOP check)[/]" if result.stop_lane else ""
     console.print(f"[bold]{intent}[/] via {result.backend}{note}", highlight=False)

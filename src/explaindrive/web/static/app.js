@@ -151,10 +151,10 @@ function renderGauges() {
   ui.clock.textContent = f ? Math.round(f.t).toString() : "0";
 }
 
-// What the car says to a line it interpreted: its question for a command, a promise to
-// explain for a "why?", the answer for a yes or no.
+// What the car says to a line it interpreted: its question for a command (or for a STOP it
+// asks about), a promise to explain for a "why?", the answer for a yes or no.
 function describeReading(e) {
-  if (e.intent) return `Car: ${e.confirmation}`;
+  if (e.intent || e.ask) return `Car: ${e.confirmation}`;
   if (e.reading === "why") return `Car: ${e.confirmation}`;
   if (e.reading === "yes" || e.reading === "no") return `You answered ${e.reading}.`;
   return "Car: I did not understand that.";
