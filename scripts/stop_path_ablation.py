@@ -7,8 +7,9 @@ Usage::
 The calibration pool (:func:`explaindrive.language.intent.corpus.calibration_pool`) is
 never trained on. For the shipped model with its thresholds, with the path and without,
 prints the STOP recall, the STOP precision, the lines without a command read as STOP, the
-negated stops (kind ``negated_stop``) read as STOP and the accuracy over the command
-requests.
+negated stops (kind ``negated_stop``) read as STOP, the accuracy over the command
+requests, and the STOP requests read as STOP or asked about (the ask band below STOP's
+threshold).
 """
 
 from __future__ import annotations
@@ -26,9 +27,17 @@ def main() -> None:
     texts = [e.text for e in pool]
     truth = [e.label if e.label in COMMAND_LABELS else "none" for e in pool]
     print(f"calibration pool: {len(pool)} lines, {truth.count('stop')} STOP requests")
-    print("stop path  STOP recall  STOP precision  none read as STOP  negated stops  accuracy")
+    print(
+        "stop path  STOP recall  STOP precision  none read as STOP  negated stops  accuracy"
+        "  read or asked"
+    )
     for on in (True, False):
-        got = [r.command or "none" for r in LineReader(stop_path=on).read(texts)]
+        readings = LineReader(stop_path=on).read(texts)
+        got = [r.command or "none" for r in readings]
+        heard = sum(
+            (g == "stop" or r.ask_stop) and t == "stop"
+            for g, r, t in zip(got, readings, truth, strict=True)
+        )
         said = [g == "stop" for g in got]
         hits = sum(s and t == "stop" for s, t in zip(said, truth, strict=True))
         negated = sum(
@@ -39,7 +48,8 @@ def main() -> None:
             f"{'on' if on else 'off':9s}  {hits / truth.count('stop'):11.3f}  "
             f"{hits / max(1, sum(said)):14.3f}  "
             f"{sum(s and t == 'none' for s, t in zip(said, truth, strict=True)):17d}  "
-            f"{negated:13d}  {sum(g == t for g, t in commands) / len(commands):8.3f}"
+            f"{negated:13d}  {sum(g == t for g, t in commands) / len(commands):8.3f}  "
+            f"{heard / truth.count('stop'):13.3f}"
         )
 
 
