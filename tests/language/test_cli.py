@@ -58,12 +58,20 @@ def test_interpret_json_and_bad_backend(interpreter) -> None:  # type: ignore[no
         "rule": None,
         "overruled": False,
         "reading": "stop",
+        "ask": None,
         "error": None,
     }
     res = runner.invoke(app, ["interpret", "Why are we slowing down?", "--json"])
     assert res.exit_code == 0, res.output
     out = json.loads(res.stdout)
     assert (out["intent"], out["reading"]) == (None, "why")  # a question, not a command
+    # STOP most probable, short of its threshold: no command, the car asks
+    res = runner.invoke(app, ["interpret", "Out.", "--json"])
+    out = json.loads(res.stdout)
+    assert (out["intent"], out["ask"]) == (None, "stop")
+    assert out["confirmation"] == "You want me to stop, is this correct?"
+    res = runner.invoke(app, ["interpret", "Out."])
+    assert "none (asks whether to stop)" in res.output
     res = runner.invoke(app, ["interpret", "hi", "--backend", "gpt9"])
     assert res.exit_code == 2 and "unknown language backend" in res.output
 
