@@ -166,14 +166,16 @@ def test_the_ask_band_asks_about_at_most_half_a_percent_of_lines_without_a_comma
     rows.append(_p(stop=0.45, why=0.55))
     negative = np.ones(len(rows), bool)
     # up to 0.60 ten are asked about (1.0 % > 0.5 %); from 0.61 four (0.4 %)
-    assert ask_stop_threshold(np.array(rows), negative, 0.9) == pytest.approx(0.61)
+    assert ask_stop_threshold(_model(), np.array(rows), negative, 0.9) == pytest.approx(0.61)
     # a STOP request at 0.6 is not a line without a command: it does not count
     rows.append(_p(stop=0.6, none=0.4))
     negative = np.append(negative, False)
-    assert ask_stop_threshold(np.array(rows), negative, 0.9) == pytest.approx(0.61)
+    assert ask_stop_threshold(_model(), np.array(rows), negative, 0.9) == pytest.approx(0.61)
     # six at 0.89 (0.6 %) under a threshold of 0.9: no band (the STOP threshold itself)
     rows = [_p(none=1.0)] * 994 + [_p(stop=0.89, none=0.11)] * 6
-    assert ask_stop_threshold(np.array(rows), np.ones(1000, bool), 0.9) == pytest.approx(0.9)
+    assert ask_stop_threshold(_model(), np.array(rows), np.ones(1000, bool), 0.9) == pytest.approx(
+        0.9
+    )
 
 
 @pytest.mark.parametrize(

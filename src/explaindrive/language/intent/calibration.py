@@ -88,24 +88,30 @@ def stop_threshold(p_negative: NDArray[np.floating]) -> float:
     return next((float(t) for t in GRID if t > top), float(GRID[-1]))
 
 
-def ask_stop_threshold(p: NDArray[np.floating], negative: NDArray[np.bool_], stop: float) -> float:
+def ask_stop_threshold(
+    model: IntentModel, p: NDArray[np.floating], negative: NDArray[np.bool_], stop: float
+) -> float:
     """The lowest threshold of :data:`GRID` (below ``stop``) that asks about at most
     :data:`MAX_STOP_ASKED` of the lines without a command (``negative``); ``stop`` itself
-    (no band) when none does.
+    (no band) when none does. Which lines fall in the band is the model's decision rule's
+    (:meth:`IntentModel.decide` with the band open down to 0).
 
     Args:
+        model: the model whose decision rule reads the rows.
         p: the readings' probabilities, one row per line of the pool.
         negative: which lines ask for no command.
         stop: the STOP threshold.
     """
     p = np.asarray(p)
-    most_stop = (p.argmax(axis=1) == STOP) & (p[:, STOP] < stop)
+    open_band = Thresholds(float(GRID[-1]), stop, 0.0)
+    band = np.array([model.decide(row, open_band).ask_stop for row in p], dtype=bool)
+    asked = band & negative
     n = max(1, int(negative.sum()))
     return next(
         (
             float(t)
             for t in GRID
-            if t < stop and (most_stop & negative & (p[:, STOP] >= t)).sum() / n <= MAX_STOP_ASKED
+            if t < stop and (asked & (p[:, STOP] >= t)).sum() / n <= MAX_STOP_ASKED
         ),
         stop,
     )
@@ -117,7 +123,7 @@ def choose_thresholds(
     """The thresholds (see the module docstring) and a printable report with the curve."""
     negative = np.array([lab not in COMMAND_LABELS for lab in labels])
     stop = stop_threshold(np.asarray(p)[negative, STOP])
-    ask = ask_stop_threshold(p, negative, stop)
+    ask = ask_stop_threshold(model, p, negative, stop)
     points = curve(model, p, labels, stop)
     command = next(
         (pt.threshold for pt in points if pt.false_command <= MAX_FALSE_COMMAND),
