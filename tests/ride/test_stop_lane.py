@@ -43,9 +43,13 @@ def test_a_real_time_ride_stops_although_the_endpoint_never_answers(
         endpoint.close()
     events = [e for r in session.records for e in r.passenger]
     read = [e for e in events if e["type"] == "interpretation"]
-    # the hurry goes to the endpoint and falls back at its deadline (openai.timeout_s)
+    # the hurry goes to the endpoint and falls back at the model's deadline
+    # (openai.timeout_s), inside the ride's budget for the line (interpret_deadline_s):
+    # the fallback, not the lane's late path, answers it
     assert (read[0]["intent"], read[0]["fallback"]) == ("fast", True)
-    assert "deadline" in read[0]["error"] and read[0]["latency_s"] < OpenAIConfig().timeout_s + 0.4
+    assert "deadline" in read[0]["error"]
+    budget = (OpenAIConfig().timeout_s, RideConfig().interpret_deadline_s)
+    assert budget[0] <= read[0]["latency_s"] < budget[1], (read[0]["latency_s"], budget)
     # the STOP is read offline at once, the endpoint is never asked
     stop = read[1]
     assert (stop["intent"], stop["stop_lane"], stop["backend"]) == ("stop", True, "embedded")

@@ -15,13 +15,15 @@ from explaindrive.language.backends.embedded import (
     TemplateExplainer,
 )
 from explaindrive.language.backends.openai import (
-    DECISION_PROMPT,
-    INTENT_PROMPT,
-    PAPER_INTENT_PROMPT,
     ChatClient,
     OpenAIDecider,
     OpenAIExplainer,
     OpenAIIntentInterpreter,
+)
+from explaindrive.language.backends.prompts import (
+    DECISION_PROMPT,
+    INTENT_PROMPT,
+    PAPER_INTENT_PROMPT,
 )
 from explaindrive.language.config import OpenAIConfig
 from explaindrive.language.explanation.decision import Factor
@@ -169,7 +171,7 @@ def test_loading_the_openai_stack_loads_the_offline_fallback() -> None:
 
 
 def test_grammar_is_sent_to_llm1_and_llm2_only_when_asked(openai_server) -> None:  # type: ignore[no-untyped-def]
-    from explaindrive.language.backends.openai import DECISION_GRAMMAR, INTENT_GRAMMAR
+    from explaindrive.language.backends.prompts import DECISION_GRAMMAR, INTENT_GRAMMAR
 
     assert DECISION_GRAMMAR == 'root ::= "[EXPLAIN]" | "[NO EXPLANATION NEEDED]"'
     on = ChatClient(
