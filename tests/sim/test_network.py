@@ -131,3 +131,30 @@ def test_trips_are_made_for_a_network_named_relative_to_the_working_directory(
     monkeypatch.chdir(net.parent)
     trips = generated_trips(Path(net.name), tmp_path / "cache")
     assert trips.is_file() and "<vehicle" in trips.read_text()
+
+
+def test_a_demand_whose_vehicle_types_are_elsewhere_is_refused(tmp_path: Path) -> None:
+    # a real scenario's routes name types its additional file defines: SUMO would stop at
+    # the first vehicle, so the file is refused before it starts, naming what to do
+    demand = tmp_path / "city.rou.xml"
+    demand.write_text(
+        '<routes><vType id="bus"/><vTypeDistribution id="mix"><vType id="m1"/>'
+        "</vTypeDistribution>"
+        '<vehicle id="a" depart="5" type="bus"><route edges="x"/></vehicle>'
+        '<vehicle id="b" depart="6" type="mix"><route edges="x"/></vehicle>'
+        '<vehicle id="c" depart="7" type="DEFAULT_VEHTYPE"><route edges="x"/></vehicle>'
+        '<vehicle id="d" depart="8"><route edges="x"/></vehicle></routes>'
+    )
+    assert demand_begin_s(demand) == 5.0
+    demand.write_text(
+        '<routes><vehicle id="Costa_0" depart="0" type="private"><route edges="x"/></vehicle>'
+        '<flow id="f" begin="0" end="9" period="3" type="taxi"><route edges="x"/></flow>'
+        '<vehicle id="Costa_1" depart="1" type="private"><route edges="x"/></vehicle></routes>'
+    )
+    with pytest.raises(NetworkError) as err:
+        demand_begin_s(demand)
+    assert str(err.value) == (
+        f"demand file {demand}: vehicle 'Costa_0' has type 'private', which the file does not "
+        "define and 1 more undefined types; put the scenario's <vType> definitions (often in "
+        "an .add.xml) into it"
+    )

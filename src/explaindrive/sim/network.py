@@ -22,6 +22,12 @@ from explaindrive.sim.scenario.files import NetworkError, ScenarioFiles, generat
 log = logging.getLogger(__name__)
 
 _DEPART_TAGS = ("vehicle", "trip", "flow", "person", "personFlow")
+_TYPE_TAGS = ("vType", "vTypeDistribution")
+SUMO_DEFAULT_TYPES = (
+    "DEFAULT_VEHTYPE", "DEFAULT_PEDTYPE", "DEFAULT_BIKETYPE", "DEFAULT_CONTAINERTYPE",
+    "DEFAULT_TAXITYPE", "DEFAULT_RAILTYPE",
+)  # fmt: skip
+"""The vehicle types SUMO defines itself: a demand file may use them without defining them."""
 
 
 def check_network_file(net_file: Path) -> None:
@@ -79,22 +85,42 @@ def demand_begin_s(demand_file: Path) -> float:
     """The first departure [s] in a route file (0 if it has none).
 
     Raises:
-        NetworkError: if the file is missing or not XML.
+        NetworkError: if the file is missing or not XML, or if a vehicle's type is neither
+            defined in the file nor one of SUMO's own (a scenario often defines its types
+            in an additional file, which SUMO would not know here).
     """
     if not demand_file.is_file():
         raise NetworkError(f"demand file not found: {demand_file}")
     first = float("inf")
+    defined: set[str] = set(SUMO_DEFAULT_TYPES)
+    used: dict[str, str] = {}  # type -> the first vehicle of it
     try:
         for _event, elem in ET.iterparse(demand_file, events=("start",)):
+            if elem.tag in _TYPE_TAGS:
+                defined.add(elem.get("id", ""))
+            if elem.tag not in _DEPART_TAGS:
+                continue
             depart = elem.get("begin" if elem.tag.endswith("Flow") or elem.tag == "flow"
                               else "depart")  # fmt: skip
-            if elem.tag in _DEPART_TAGS and depart is not None:
+            vtype = elem.get("type")
+            if vtype is not None:
+                used.setdefault(vtype, elem.get("id", "?"))
+            if depart is not None:
                 try:
                     first = min(first, float(depart))
                 except ValueError:
                     continue  # "triggered" and the like
     except ET.ParseError as exc:
         raise NetworkError(f"demand file {demand_file} is not XML: {exc}") from None
+    unknown = sorted(set(used) - defined)
+    if unknown:
+        vtype = unknown[0]
+        more = f" and {len(unknown) - 1} more undefined types" if len(unknown) > 1 else ""
+        raise NetworkError(
+            f"demand file {demand_file}: vehicle {used[vtype]!r} has type {vtype!r}, which the "
+            f"file does not define{more}; put the scenario's <vType> definitions (often in an "
+            ".add.xml) into it"
+        )
     return 0.0 if first == float("inf") else first
 
 
