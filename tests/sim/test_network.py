@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gzip
 import itertools
 from collections.abc import Callable
 from pathlib import Path
@@ -158,3 +159,25 @@ def test_a_demand_whose_vehicle_types_are_elsewhere_is_refused(tmp_path: Path) -
         "define and 1 more undefined types; put the scenario's <vType> definitions (often in "
         "an .add.xml) into it"
     )
+
+
+def test_a_compressed_network_and_demand_are_read_as_sumo_reads_them(
+    netgen: Callable[..., Path], tmp_path: Path
+) -> None:
+    # real scenarios ship .net.xml.gz and .rou.xml.gz, which SUMO and sumolib read as they are
+    net = tmp_path / "grid.net.xml.gz"
+    net.write_bytes(gzip.compress(netgen("grid", *GRID_WITH_LIGHTS).read_bytes()))
+    demand = tmp_path / "morning.rou.xml.gz"
+    demand.write_bytes(
+        gzip.compress(
+            b'<routes><vType id="car"/>'
+            b'<trip id="a" depart="25230" from="A1B1" to="D1E1" type="car"/></routes>'
+        )
+    )
+    files = own_network(net, ("A1B1", "D1E1"), tmp_path / "cache", demand)
+    assert files.route_edges == ("A1B1", "B1C1", "C1D1", "D1E1")
+    assert (files.begin_s, files.demand_files) == (25230.0, (demand,))
+    broken = tmp_path / "broken.net.xml.gz"
+    broken.write_bytes(gzip.compress(b"<net><edge")[:-4])  # cut short
+    with pytest.raises(NetworkError, match=r"broken\.net\.xml\.gz is not a SUMO network"):
+        route_edges(broken, "A1B1", "D1E1")

@@ -13,6 +13,8 @@ for each level).
 
 from __future__ import annotations
 
+import gzip
+import io
 import logging
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -20,6 +22,9 @@ from pathlib import Path
 from explaindrive.sim.scenario.files import NetworkError, ScenarioFiles, generated_trips
 
 log = logging.getLogger(__name__)
+
+XmlStream = gzip.GzipFile | io.BufferedReader
+"""A network or route file opened for reading (:func:`open_xml`)."""
 
 _DEPART_TAGS = ("vehicle", "trip", "flow", "person", "personFlow")
 _TYPE_TAGS = ("vType", "vTypeDistribution")
@@ -30,20 +35,27 @@ SUMO_DEFAULT_TYPES = (
 """The vehicle types SUMO defines itself: a demand file may use them without defining them."""
 
 
+def open_xml(path: Path) -> XmlStream:
+    """``path`` opened for reading, gzip-compressed or not (SUMO reads both, and real
+    scenarios often ship ``.net.xml.gz`` and ``.rou.xml.gz``)."""
+    with path.open("rb") as head:
+        compressed = head.read(2) == b"\x1f\x8b"
+    return gzip.GzipFile(path, "rb") if compressed else path.open("rb")
+
+
 def check_network_file(net_file: Path) -> None:
     """Raise :class:`NetworkError` unless ``net_file`` is a SUMO network file."""
     if not net_file.is_file():
         raise NetworkError(f"network file not found: {net_file}")
     try:
-        for _event, elem in ET.iterparse(net_file, events=("start",)):
-            if elem.tag != "net":
-                raise NetworkError(
-                    f"{net_file} is not a SUMO network (its root element is <{elem.tag}>, "
-                    "not <net>)"
-                )
-            return
-    except ET.ParseError as exc:
+        with open_xml(net_file) as stream:
+            root = next(ET.iterparse(stream, events=("start",)))[1]
+    except (ET.ParseError, OSError, EOFError) as exc:
         raise NetworkError(f"{net_file} is not a SUMO network (not XML: {exc})") from None
+    if root.tag != "net":
+        raise NetworkError(
+            f"{net_file} is not a SUMO network (its root element is <{root.tag}>, not <net>)"
+        )
 
 
 def parse_route(text: str) -> tuple[str, str]:
@@ -82,7 +94,7 @@ def route_edges(net_file: Path, from_edge: str, to_edge: str) -> tuple[str, ...]
 
 
 def demand_begin_s(demand_file: Path) -> float:
-    """The first departure [s] in a route file (0 if it has none).
+    """The first departure [s] in a route file, plain or gzip-compressed (0 if it has none).
 
     Raises:
         NetworkError: if the file is missing or not XML, or if a vehicle's type is neither
@@ -91,28 +103,12 @@ def demand_begin_s(demand_file: Path) -> float:
     """
     if not demand_file.is_file():
         raise NetworkError(f"demand file not found: {demand_file}")
-    first = float("inf")
-    defined: set[str] = set(SUMO_DEFAULT_TYPES)
-    used: dict[str, str] = {}  # type -> the first vehicle of it
     try:
-        for _event, elem in ET.iterparse(demand_file, events=("start",)):
-            if elem.tag in _TYPE_TAGS:
-                defined.add(elem.get("id", ""))
-            if elem.tag not in _DEPART_TAGS:
-                continue
-            depart = elem.get("begin" if elem.tag.endswith("Flow") or elem.tag == "flow"
-                              else "depart")  # fmt: skip
-            vtype = elem.get("type")
-            if vtype is not None:
-                used.setdefault(vtype, elem.get("id", "?"))
-            if depart is not None:
-                try:
-                    first = min(first, float(depart))
-                except ValueError:
-                    continue  # "triggered" and the like
-    except ET.ParseError as exc:
+        with open_xml(demand_file) as stream:
+            first, defined, used = _read_demand(stream)
+    except (ET.ParseError, OSError, EOFError) as exc:
         raise NetworkError(f"demand file {demand_file} is not XML: {exc}") from None
-    unknown = sorted(set(used) - defined)
+    unknown = sorted(set(used) - defined - set(SUMO_DEFAULT_TYPES))
     if unknown:
         vtype = unknown[0]
         more = f" and {len(unknown) - 1} more undefined types" if len(unknown) > 1 else ""
@@ -122,6 +118,29 @@ def demand_begin_s(demand_file: Path) -> float:
             ".add.xml) into it"
         )
     return 0.0 if first == float("inf") else first
+
+
+def _read_demand(stream: XmlStream) -> tuple[float, set[str], dict[str, str]]:
+    """A route file's first departure [s] (``inf`` if none), the vehicle types it defines,
+    and the types its vehicles use, each with the first vehicle of it."""
+    first = float("inf")
+    defined: set[str] = set()
+    used: dict[str, str] = {}
+    for _event, elem in ET.iterparse(stream, events=("start",)):
+        if elem.tag in _TYPE_TAGS:
+            defined.add(elem.get("id", ""))
+        if elem.tag not in _DEPART_TAGS:
+            continue
+        vtype = elem.get("type")
+        if vtype is not None:
+            used.setdefault(vtype, elem.get("id", "?"))
+        depart = elem.get("begin" if elem.tag.endswith("Flow") or elem.tag == "flow"
+                          else "depart")  # fmt: skip
+        try:
+            first = min(first, float(depart)) if depart is not None else first
+        except ValueError:
+            continue  # "triggered" and the like
+    return first, defined, used
 
 
 def own_network(
