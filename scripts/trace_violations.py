@@ -12,7 +12,8 @@ the network sees a noisy observation, as ``explaindrive evaluate --obs-noise`` h
 network trained on the speed estimate sees the estimate in place of the speed reading, and
 the row shows it); each step then shows the true state on a second line. With
 ``--scenario`` the episode runs on a scenario directory (``explaindrive scenario random
---seed S --out DIR``). A collision also prints SUMO's record of it (who hit whom, on which
+--seed S --out DIR``), with ``--net NET --route FROM,TO [--demand FILE]`` on a network of
+your own. A collision also prints SUMO's record of it (who hit whom, on which
 lane).
 """
 
@@ -48,6 +49,16 @@ def _print_collisions(env: UrbanDriveEnv) -> None:
               f"{c.pos:.1f} m: {c.type}")  # fmt: skip
 
 
+def _own_network(args: argparse.Namespace) -> dict[str, object]:
+    """The env's fields for ``--net``, ``--route`` and ``--demand``, if given."""
+    if args.net is None:
+        return {}
+    if args.route is None:
+        raise SystemExit("--net needs --route FROM_EDGE,TO_EDGE")
+    fields: dict[str, object] = {"net_file": args.net, "route": tuple(args.route.split(","))}
+    return fields | ({"demand_file": args.demand} if args.demand else {})
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("policy", type=Path, help="a policy .pt file")
@@ -58,6 +69,9 @@ def main() -> None:
     parser.add_argument("--before", type=int, default=6, help="steps shown before each event")
     parser.add_argument("--obs-noise", default="0,0", help="SD_M,SD_MPS on what the network sees")
     parser.add_argument("--scenario", default=None, help="a scenario directory (default: paper)")
+    parser.add_argument("--net", default=None, help="a network of your own (needs --route)")
+    parser.add_argument("--route", default=None, help="FROM_EDGE,TO_EDGE on --net")
+    parser.add_argument("--demand", default=None, help="background traffic on --net (.rou.xml)")
     parser.add_argument("--shield", action="store_true", help="act through the run-time shield")
     args = parser.parse_args()
 
@@ -76,6 +90,7 @@ def main() -> None:
             yellow_leader=agent.yellow_leader,
             obs_noise=(noise.sd_m, noise.sd_mps),
             **({"scenario": args.scenario} if args.scenario else {}),
+            **_own_network(args),
         )
     )
     obs, info = env.reset(
