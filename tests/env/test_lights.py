@@ -89,3 +89,20 @@ def test_gentle_rule_drives_through_the_dilemma_zone_and_red_always_binds() -> N
 def test_an_unknown_yellow_rule_is_named() -> None:
     with pytest.raises(ValueError, match="unknown yellow rule 'sometimes'"):
         AmberDecision.for_rule("sometimes")
+
+
+def test_each_stop_line_of_a_joined_cluster_is_decided_when_its_yellow_is_first_seen() -> None:
+    # one programme, two stop lines 29 m apart, both turning yellow at 12 m/s: the first is
+    # 17.75 m ahead (stopping needs 20 m: through), the second 46.8 m (gently: 10 m this
+    # step and 8 + 6 + 4 + 2 m after it, with a 2 m margin, 32 m: stop there)
+    amber = AmberDecision(gentle=True)
+    assert amber.leaders([("A1", YELLOW, 17.75), ("A2", YELLOW, 46.8)], 12.0) == [False, True]
+    assert amber.leaders([("A1", YELLOW, 5.75), ("A2", YELLOW, 34.8)], 12.0) == [False, True]
+    # past the first line, the second's decision holds: its yellow is two steps old, and
+    # decided afresh (it clears within 2 s, as if its yellow had just begun) it is through
+    assert amber.leaders([("A2", YELLOW, 22.8)], 12.0) == [True]
+    assert not AmberDecision(gentle=True).is_leader("A2", YELLOW, 12.0, 22.8)
+    # a red further on is a leader too; once a line is out of sight, its decision goes
+    assert amber.leaders([("A2", YELLOW, 10.8), ("A3", RED, 60.0)], 12.0) == [True, True]
+    amber.leaders([("B", GREEN, 150.0)], 12.0)
+    assert amber.decided == {}

@@ -14,6 +14,7 @@ from explaindrive.env.perception import (
     LeaderSensor,
     LightReading,
     SignalLink,
+    cluster_onward,
     effective_leader,
     light_ahead,
     observation,
@@ -51,6 +52,14 @@ def test_the_light_ahead_is_the_nearest_link_of_the_ego_with_its_own_signal() ->
     assert light_ahead(links[1:]) == LightReading(97.0, S.LightState.RED, ("C", 16))
     assert light_ahead(links[2:]) == LightReading()  # J2 at 360 m: beyond sensor range
     assert light_ahead(()) == LightReading()
+
+
+def test_the_later_stop_lines_of_the_nearest_links_programme_are_read_on() -> None:
+    links = signal_links(FakeSumo(links=LINKS))
+    # C's second line (red, 97 m); J2 is another programme, and beyond range besides
+    assert cluster_onward(links) == [(("C", 16), S.LightState.RED, 97.0)]
+    assert cluster_onward(links[1:]) == []  # past C: J2 alone is ahead
+    assert cluster_onward(()) == []
 
 
 def test_a_pedestrian_in_the_ego_lane_makes_the_crossing_busy() -> None:

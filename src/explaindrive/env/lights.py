@@ -23,8 +23,8 @@ the decision has it, with no hard braking for a yellow it may legally drive thro
 
 from __future__ import annotations
 
-from collections.abc import Hashable
-from dataclasses import dataclass
+from collections.abc import Hashable, Sequence
+from dataclasses import dataclass, field
 
 from explaindrive.env.actions import STOP_MARGIN_M, braking_distance, can_stop_before
 from explaindrive.env.state import LightState
@@ -54,41 +54,64 @@ def clears(speed_mps: float, d_tl: float) -> bool:
 
 @dataclass(slots=True)
 class AmberDecision:
-    """The ego's decision at the yellow of the light ahead, kept until that yellow ends."""
+    """The ego's decisions at the yellow of the lights ahead, each kept until its yellow ends.
 
-    light_id: Hashable | None = None
-    """The light the decision is about (``None``: no yellow decided); in the env, a
-    signalled link (its traffic light id and link index)."""
-    stops: bool = True
-    """Whether the ego stops for that light's yellow."""
+    A joined cluster (one programme for several nearby junctions) has several stop lines on
+    the ego's way, and one yellow starts at all of them: each line is decided when its yellow
+    is first seen, at its own distance, so a car that is committed at the first line but can
+    stop before the next one stops there (the next line is a leader while the first is
+    shown green), and does not meet the next line's yellow, already half over, as new.
+    """
+
+    decided: dict[Hashable, bool] = field(default_factory=dict)
+    """light -> whether the ego stops for its yellow (in the env, a light is a signalled
+    link: its traffic light id and link index)."""
     always: bool = False
     """Every yellow is a leader (the paper's rule): nothing is decided."""
     gentle: bool = False
     """Decide by the ``gentle`` rule (module docstring) instead of the hardest braking."""
 
+    def decide(self, speed_mps: float, d_tl: float) -> bool:
+        """Whether the ego, at ``speed_mps`` and ``d_tl`` [m] from a stop line whose light
+        has just turned yellow, stops for it."""
+        stops = can_stop_before(speed_mps, d_tl)
+        if self.gentle:
+            stops = stops and (stops_gently(speed_mps, d_tl) or not clears(speed_mps, d_tl))
+        return stops
+
+    def leaders(
+        self, seen: Sequence[tuple[Hashable, LightState, float]], speed_mps: float
+    ) -> list[bool]:
+        """Whether the stop line of each light of ``seen`` is a virtual leader this step.
+
+        Args:
+            seen: ``(light, its colour this step, [m] from the ego's front to its stop
+                line)`` of the lights ahead this step (a light of ``None``: none in range;
+                its colour is then green). A decision about a light that is not among them
+                yellow is forgotten: its next yellow is decided afresh.
+            speed_mps: the ego's speed.
+        """
+        yellow = {light for light, colour, _d in seen if colour is LightState.YELLOW}
+        for light in [light for light in self.decided if light not in yellow]:
+            del self.decided[light]
+        flags = []
+        for light, colour, d_tl in seen:
+            if colour is not LightState.YELLOW:
+                flags.append(colour is LightState.RED)
+            elif self.always:
+                flags.append(True)
+            else:
+                if light not in self.decided:
+                    self.decided[light] = self.decide(speed_mps, d_tl)
+                flags.append(self.decided[light])
+        return flags
+
     def is_leader(
         self, light_id: Hashable | None, colour: LightState, speed_mps: float, d_tl: float
     ) -> bool:
-        """Whether the stop line of light ``light_id`` ahead is a virtual leader this step.
-
-        Args:
-            light_id: the light ahead within sensor range (``None``: none in range; its
-                colour is then green, and the next yellow is decided afresh).
-            colour: its colour this step.
-            speed_mps: the ego's speed.
-            d_tl: [m] from the ego's front to its stop line.
-        """
-        if colour is not LightState.YELLOW:
-            self.light_id = None
-            return colour is LightState.RED
-        if self.always:
-            return True
-        if self.light_id != light_id:
-            stops = can_stop_before(speed_mps, d_tl)
-            if self.gentle:
-                stops = stops and (stops_gently(speed_mps, d_tl) or not clears(speed_mps, d_tl))
-            self.light_id, self.stops = light_id, stops
-        return self.stops
+        """Whether the stop line of light ``light_id``, the only one ahead, is a virtual
+        leader this step (:meth:`leaders`)."""
+        return self.leaders([(light_id, colour, d_tl)], speed_mps)[0]
 
     def shown_colour(self, colour: LightState, leader: bool) -> LightState:
         """The colour the ego is shown for a light whose line :meth:`is_leader` just judged:

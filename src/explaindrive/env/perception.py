@@ -32,6 +32,7 @@ from explaindrive.env import state as S
 from explaindrive.env.lane_split import SplitSensor, vehicle_length
 from explaindrive.env.lights import AmberDecision
 from explaindrive.env.right_of_way import NO_YIELD, YieldReading, YieldSensor
+from explaindrive.env.way_ahead import WayAhead
 from explaindrive.sim.crossing_lanes import CrossingLane, pedestrian_in_lane
 from explaindrive.sim.pedestrians import KerbYield
 from explaindrive.sim.route import RouteCrossing, RouteGeometry
@@ -115,8 +116,10 @@ class LeaderSensor:
 
     SUMO's leader of the ego (``VAR_LEADER``, read after each step), so a vehicle that
     changes into the ego's lane ahead is the leader from the step it is in the lane, and
-    one beside the ego is none (tests/env/test_cut_in.py); or, if nearer, a vehicle in the
-    other branch of a lane split whose back is still in the ego's way
+    one beside the ego is none (tests/env/test_cut_in.py); or, if nearer, a vehicle on the
+    ego's lanes ahead that SUMO's leader leaves out
+    (:class:`~explaindrive.env.way_ahead.WayAhead`, tests/env/test_way_ahead.py), or a
+    vehicle in the other branch of a lane split whose back is still in the ego's way
     (:class:`~explaindrive.env.lane_split.SplitSensor`, tests/env/test_lane_split.py).
 
     Args:
@@ -128,22 +131,27 @@ class LeaderSensor:
         self.ego_min_gap_m = ego_min_gap_m
         self._lengths = lengths
         self.splits = SplitSensor(lengths)
+        self.ahead = WayAhead(lengths)
 
     def __call__(self, api: Any, ego: Any, next_links: Sequence[Any]) -> Leader | None:
-        """The real leader from the ego's subscription results ``ego``: SUMO's, or a vehicle
-        in the other branch of a lane split that is still in the ego's way
-        (:mod:`explaindrive.env.lane_split`; ``next_links``: the ego's
-        ``vehicle.getNextLinks`` this step), whichever is nearer."""
+        """The real leader from the ego's subscription results ``ego``: SUMO's, a vehicle on
+        the ego's lanes ahead (:mod:`explaindrive.env.way_ahead`), or a vehicle in the other
+        branch of a lane split that is still in the ego's way
+        (:mod:`explaindrive.env.lane_split`), whichever is nearer (``next_links``: the ego's
+        ``vehicle.getNextLinks`` this step)."""
         lead = ego.get(tc.VAR_LEADER)
         gap, lid = S.SENSOR_RANGE_M, ""
         if lead and lead[0]:
             gap, lid = float(lead[1]) + self.ego_min_gap_m, lead[0]
         lane = ego.get(tc.VAR_LANE_ID)
-        split = (
-            self.splits(api, lane, float(ego[tc.VAR_LANEPOSITION]), next_links) if lane else None
-        )
-        if split is not None and split[0] < gap:
-            gap, lid = split
+        if lane:
+            pos = float(ego[tc.VAR_LANEPOSITION])
+            ahead = self.ahead(api, lane, pos, next_links, within_m=gap)
+            if ahead is not None:
+                gap, lid = ahead
+            split = self.splits(api, lane, pos, next_links)
+            if split is not None and split[0] < gap:
+                gap, lid = split
         if gap >= S.SENSOR_RANGE_M:
             return None
         length = vehicle_length(api, self._lengths, lid)
@@ -183,6 +191,23 @@ def light_ahead(links: tuple[SignalLink, ...]) -> LightReading:
         colour = S.LightState.from_sumo(link.state)
         return LightReading(link.gap_m, colour, (link.tls_id, link.link_index))
     return NO_LIGHT
+
+
+def cluster_onward(
+    links: tuple[SignalLink, ...],
+) -> list[tuple[tuple[str, int], S.LightState, float]]:
+    """The later stop lines within sensor range of the programme of the nearest of ``links``
+    (a joined cluster's), as ``(light, colour, gap [m])``: a red or a yellow the ego stops
+    for there is a virtual leader while the nearest line is green or gone through
+    (:class:`~explaindrive.env.lights.AmberDecision`)."""
+    if not links:
+        return []
+    tls_id = links[0].tls_id
+    return [
+        ((link.tls_id, link.link_index), S.LightState.from_sumo(link.state), link.gap_m)
+        for link in links[1:]
+        if link.tls_id == tls_id and link.gap_m < S.SENSOR_RANGE_M
+    ]
 
 
 def link_colour(api: Any, link: SignalLink) -> S.LightState:
@@ -358,7 +383,12 @@ class Perception:
         real = self.leaders(api, ego, next_links)
         links = signal_links(api)
         light = light_ahead(links)
-        at_line = amber.is_leader(light.light_id, light.colour, v, light.gap_m)
+        onward = cluster_onward(links)
+        flags = amber.leaders([(light.light_id, light.colour, light.gap_m), *onward], v)
+        at_line = flags[0]
+        line_gap = light.gap_m if at_line else S.SENSOR_RANGE_M
+        for (_light, _colour, gap_m), leads in zip(onward, flags[1:], strict=True):
+            line_gap = min(line_gap, gap_m) if leads else line_gap
         true_colour = light.colour
         shown = amber.shown_colour(true_colour, at_line)
         if shown is not true_colour:
@@ -366,6 +396,7 @@ class Perception:
         crossings = self.crossings(api, pos_m, kerb)
         limit = self.geometry.posted_limit(pos_m)
         yields = self.yields(api, pos_m, v, limit, next_links)
-        leader = effective_leader(real, at_line, light.gap_m, crossings.gap_m, yields.leader_gap_m)
+        leader = effective_leader(real, line_gap < S.SENSOR_RANGE_M, line_gap, crossings.gap_m,
+                                  yields.leader_gap_m)  # fmt: skip
         obs = observation(command, v, limit, leader, light, crossings.gap_m)
         return Percept(obs, leader, real, links, crossings, true_colour, yields)

@@ -40,6 +40,7 @@ from explaindrive.env.actions import (
 from explaindrive.env.config import EnvConfig
 from explaindrive.env.episode import Episode, StepRecord
 from explaindrive.env.lights import AmberDecision
+from explaindrive.env.odometer import RouteOdometer
 from explaindrive.env.options import ResetOptions
 from explaindrive.env.perception import LeaderSensor, Percept, Perception
 from explaindrive.env.render import TopDownView
@@ -121,6 +122,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._ep: Episode | None = None
         self._entry: EgoEntry | None = None
         self._leader_lengths: dict[str, float] = {}  # vehicle id -> length [m]
+        self._odometer = RouteOdometer(self.geometry, 0.0)
         self._last_obs = np.zeros(S.STATE_DIM, dtype=np.float32)
         self._view: TopDownView | None = None
 
@@ -208,6 +210,7 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
         )
         ep.apply_schedule()
         ep.pos_m = entry.start_pos_m
+        self._odometer = RouteOdometer(self.geometry, entry.start_pos_m)
         ep.seen = self._perceive(self._sumo.ego_state())
         obs = self._last_obs = ep.seen.obs
         info = {
@@ -333,7 +336,11 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise
         ep.steps += 1
         if motion.ego is not None:
-            ep.pos_m = ep.start_pos_m + float(motion.ego[tc.VAR_DISTANCE])
+            ego = motion.ego
+            ep.pos_m = self._odometer(
+                self._sumo.api, str(ego[tc.VAR_LANE_ID]), float(ego[tc.VAR_LANEPOSITION]),
+                float(ego[tc.VAR_DISTANCE]),
+            )  # fmt: skip
         else:
             ep.pos_m += motion.speed_mps * STEP_LENGTH_S
         return motion

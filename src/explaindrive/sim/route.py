@@ -76,6 +76,16 @@ class RouteGeometry:
     lights: tuple[RouteLight, ...]
     crossings: tuple[RouteCrossing, ...]
     junctions: tuple[RouteJunction, ...] = ()
+    edge_stop_m: tuple[float, ...] = ()  # [m] route position of each edge's end (its stop line)
+
+    def edge_end_m(self, index: int) -> float:
+        """[m] The route position of the end of route edge ``index`` (the stop line before
+        the next junction; a geometry without ``edge_stop_m``: the next edge's start, or the
+        route's end)."""
+        if self.edge_stop_m:
+            return self.edge_stop_m[index]
+        starts = self.edge_start_m
+        return starts[index + 1] if index + 1 < len(starts) else self.length_m
 
     def junction_at(self, pos_m: float) -> RouteJunction | None:
         """The junction whose area (stop line to the next edge) holds ``pos_m``, if any."""
@@ -154,6 +164,7 @@ def load_route_geometry(
         lights=tuple(lights),
         crossings=tuple(crossings),
         junctions=tuple(_route_junctions(net, route_edges, layout, crossings)),
+        edge_stop_m=tuple(layout.ends),
     )
 
 
@@ -200,6 +211,7 @@ class _Layout:
     """Positions along the route [m]: edge starts and ends, speed zones, total length."""
 
     starts: list[float]
+    ends: list[float]
     end: dict[str, float]
     zone_start: list[float]
     zone_limit: list[float]
@@ -208,7 +220,7 @@ class _Layout:
 
 def _lay_out(net: Any, road: _CarLanes, route_edges: tuple[str, ...], net_file: Path) -> _Layout:
     """Walk the route edge by edge, through the junctions' internal lanes."""
-    layout = _Layout([], {}, [], [], 0.0)
+    layout = _Layout([], [], {}, [], [], 0.0)
     pos = 0.0
     for i, eid in enumerate(route_edges):
         if eid not in road.edge_lane:
@@ -221,6 +233,7 @@ def _lay_out(net: Any, road: _CarLanes, route_edges: tuple[str, ...], net_file: 
             layout.zone_limit.append(speed)
         pos += lane.getLength()
         layout.end[eid] = pos
+        layout.ends.append(pos)
         if i + 1 < len(route_edges):
             conn = road.conns.get((eid, route_edges[i + 1]))
             if conn is None:
