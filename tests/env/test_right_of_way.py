@@ -218,6 +218,22 @@ def test_entering_the_conflict_in_front_of_a_foe_with_priority_is_a_violation() 
     assert not enters_in_front(no_priority, at_12, 4.0, 5.0)
 
 
+def test_an_ego_driving_off_from_a_wait_is_judged_clearing_as_it_accelerates() -> None:
+    at_12 = FoeMotion(12.0, 2.6, 13.89, 5.0)
+    # as above, 13 m to clear at 4 m/s: 3.25 s, with the gap 4.25 s; a foe 40 m away
+    # arrives at 3.33 s: a violation at a held speed
+    assert enters_in_front(_conflict(2.0, 40.0, 46.0), at_12, 4.0, 5.0)
+    # accelerating at 2 m/s^2: 4 t + t^2 = 13, t = sqrt(17) - 2 = 2.12 s, with the gap
+    # 3.12 s: the foe at 40 m (3.33 s) is none, one at 36 m (3.0 s) is one
+    assert not enters_in_front(_conflict(2.0, 40.0, 46.0), at_12, 4.0, 5.0, 2.0)
+    assert enters_in_front(_conflict(2.0, 36.0, 42.0), at_12, 4.0, 5.0, 2.0)
+    # at most SUMO's default 2.6 m/s^2: 4 t + 1.3 t^2 = 13, t = 1.98 s, with the gap 2.98 s
+    assert not enters_in_front(_conflict(2.0, 36.0, 42.0), at_12, 4.0, 5.0, 5.0)
+    assert enters_in_front(_conflict(2.0, 35.0, 41.0), at_12, 4.0, 5.0, 5.0)  # 2.92 s
+    # braking is judged as a held speed
+    assert enters_in_front(_conflict(2.0, 40.0, 46.0), at_12, 4.0, 5.0, -3.0)
+
+
 def _drive(
     env: UrbanDriveEnv,
     foe_at_step: int,

@@ -90,6 +90,20 @@ def test_entering_a_conflict_area_in_front_of_a_foe_is_a_yield_violation() -> No
     assert not judge()(api, 396.0, 400.0, (), {}, (far,)).yield_violation
 
 
+def test_the_judge_reads_the_egos_acceleration_from_its_travel_step_to_step() -> None:
+    # the conflict 2 m ahead, the foe at 12 m/s 40 m from it (arrives at 3.33 s); the ego
+    # enters at 4 m/s and must clear 13 m: at a held speed 3.25 s + 1 s gap, a violation
+    foe = JunctionFoe("car", 2.0, 40.0, 8.0, 46.0, ":P_1_0", ":P_4_0", True, False)
+    conflict = Conflict(foe, FoeMotion(12.0, 2.6, 13.89, 5.0))
+    api = FakeSumo()
+    assert judge()(api, 396.0, 400.0, (), {}, (conflict,)).yield_violation
+    # after a step of 2 m, the 4 m step drove off at 2 m/s^2: 4 t + t^2 = 13 gives 2.12 s,
+    # with the gap 3.12 s, before the foe
+    driving_off = judge()
+    assert not driving_off(api, 394.0, 396.0, (), {}).yield_violation
+    assert not driving_off(api, 396.0, 400.0, (), {}, (conflict,)).yield_violation
+
+
 def test_collisions_and_speeding() -> None:
     assert ego_collided(FakeSumo(collisions=(("car", "ego"),)))
     assert not ego_collided(FakeSumo(collisions=(("car", "bus"),)))

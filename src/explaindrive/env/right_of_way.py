@@ -60,7 +60,9 @@ way when its front enters a conflict area during a step (the area's start, seen 
 step, lies within the step's travel) while a foe with priority (``egoResponse``, its link not
 red) has not left the area and will reach it before the ego's back has left it plus SUMO's
 own gap, :data:`YIELD_JUDGE_GAP_S`. Both times are at the speeds they drive (no hardest
-acceleration here): the ego's over the step, the foe's as read before it; a standing foe
+acceleration here): the ego's over the step, with the acceleration it drove the step with
+held while it clears (up to SUMO's default 2.6 m/s²: a car driving off from a wait at the
+line clears as it accelerates), the foe's as read before it; a standing foe
 that has not entered never arrives, one standing inside never leaves. SUMO's drivers may
 cross the stop line and wait short of the conflict (inside the junction for a left turn)
 until their own gap rule lets them in, which is no violation: only the entry into the area
@@ -236,20 +238,27 @@ def foe_window_s(foe: JunctionFoe, motion: FoeMotion) -> tuple[float, float]:
 
 
 def enters_in_front(
-    foe: JunctionFoe, motion: FoeMotion, travelled_m: float, ego_length_m: float
+    foe: JunctionFoe,
+    motion: FoeMotion,
+    travelled_m: float,
+    ego_length_m: float,
+    ego_accel_mps2: float = 0.0,
 ) -> bool:
     """The judge (module docstring): whether the ego, whose front travels ``travelled_m``
     during a step that starts with ``foe`` as read, enters their conflict area in front of a
     foe with priority over its link.
 
     The ego drives the step at ``travelled_m`` per :data:`STEP_LENGTH_S` (SUMO moves a car
-    by its new speed); the times count from the step's start.
+    by its new speed) and clears the area at that speed, or, if it accelerated during the
+    step, with that acceleration held (at most :data:`FOE_ACCEL_MPS2`); the times count
+    from the step's start.
 
     Args:
         foe: the foe and the conflict, read before the step.
         motion: the foe's speed, length and link state, read before the step.
         travelled_m: how far the ego's front moved during the step.
         ego_length_m: the ego's length.
+        ego_accel_mps2: the ego's acceleration during the step (its speed's rise over it).
     """
     if not 0.0 < foe.ego_dist_m <= travelled_m:  # no entry this step
         return False
@@ -257,11 +266,10 @@ def enters_in_front(
         return False
     ego_speed_mps = travelled_m / STEP_LENGTH_S
     ego_enters = foe.ego_dist_m / ego_speed_mps
-    ego_leaves = (foe.ego_exit_m + ego_length_m) / ego_speed_mps
+    accel = min(max(ego_accel_mps2, 0.0), FOE_ACCEL_MPS2)
     if foe.turning:  # it drives on from its wait at the internal junction: accelerating
-        ego_leaves = arrival_time_s(
-            foe.ego_exit_m + ego_length_m, ego_speed_mps, FOE_ACCEL_MPS2, math.inf
-        )
+        accel = FOE_ACCEL_MPS2
+    ego_leaves = arrival_time_s(foe.ego_exit_m + ego_length_m, ego_speed_mps, accel, math.inf)
     foe_arrives, foe_leaves = foe_window_s(foe, motion)
     return foe_leaves > ego_enters and foe_arrives < ego_leaves + YIELD_JUDGE_GAP_S
 

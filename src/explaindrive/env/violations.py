@@ -26,6 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from explaindrive.env.actions import STEP_LENGTH_S
 from explaindrive.env.perception import CrossingSensor, SignalLink, link_colour
 from explaindrive.env.right_of_way import Conflict, enters_in_front
 from explaindrive.env.state import LightState
@@ -77,6 +78,7 @@ class ViolationJudge:
         self.crossings = crossings
         self.geometry = geometry
         self.ego_length_m = ego_length_m
+        self._travelled_m: float | None = None  # the ego's travel in the step before [m]
 
     def __call__(
         self,
@@ -106,9 +108,13 @@ class ViolationJudge:
     def entered_in_front(self, conflicts: tuple[Conflict, ...], travelled_m: float) -> bool:
         """The ego's front, travelling ``travelled_m`` this step, entered one of
         ``conflicts`` in front of its foe with priority
-        (:func:`~explaindrive.env.right_of_way.enters_in_front`)."""
+        (:func:`~explaindrive.env.right_of_way.enters_in_front`; called once a step: the
+        ego's acceleration is its travel's rise since the step before)."""
+        before, self._travelled_m = self._travelled_m, travelled_m
+        accel = 0.0 if before is None else (travelled_m - before) / STEP_LENGTH_S**2
         return any(
-            enters_in_front(c.foe, c.motion, travelled_m, self.ego_length_m) for c in conflicts
+            enters_in_front(c.foe, c.motion, travelled_m, self.ego_length_m, accel)
+            for c in conflicts
         )
 
     def site_at(self, pos_m: float) -> str:
