@@ -132,6 +132,10 @@ def test_invalid_values_are_rejected(changes: dict[str, Any], message: str) -> N
 def test_overrides_are_parsed_as_yaml_and_coerced() -> None:
     assert build_config("paper", overrides=dict([parse_override("lr=3e-4")])).lr == 3e-4
     assert parse_override("hidden_sizes=[64, 32]") == ("hidden_sizes", [64, 32])
+    assert parse_override("obs_noise_max=0,0.5") == ("obs_noise_max", [0, 0.5])
+    assert parse_override("name=a,b") == ("name", "a,b")  # text with a comma stays text
+    c = build_config("passenger", overrides=dict([parse_override("obs_noise_max=0,0")]))
+    assert c.obs_noise_max == (0.0, 0.0)
     c = build_config("paper", overrides=dict([parse_override("hidden_sizes=[64, 32]")]))
     assert c.hidden_sizes == (64, 32)
     assert PAPER.replace(lr=1).lr == 1.0 and isinstance(PAPER.replace(lr=1).lr, float)

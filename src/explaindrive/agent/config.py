@@ -411,7 +411,9 @@ def load_config_file(path: str | Path) -> dict[str, Any]:
 
 
 def parse_override(item: str) -> tuple[str, Any]:
-    """Parse one ``key=value`` override; the value is read as YAML (``3e-4``, ``[64, 64]``).
+    """Parse one ``key=value`` override; the value is read as YAML (``3e-4``, ``[64, 64]``),
+    and numbers separated by commas as a list, as the command line's own options write
+    them (``obs_noise_max=0,0`` is ``[0, 0]``).
 
     Raises:
         ConfigError: if ``item`` has no ``=``.
@@ -421,6 +423,10 @@ def parse_override(item: str) -> tuple[str, Any]:
         raise ConfigError(f"override {item!r} must look like key=value")
     try:
         value = read_yaml(raw)
+        if isinstance(value, str) and "," in value:
+            parts = [read_yaml(part) for part in value.split(",")]
+            if all(isinstance(p, int | float) and not isinstance(p, bool) for p in parts):
+                value = parts
     except yaml.YAMLError as exc:
         raise ConfigError(f"cannot parse the value of override {item!r}: {exc}") from exc
     return key.strip(), value
