@@ -211,6 +211,7 @@ def test_info_carries_the_reward_terms(make_env):
         "brake",
         "approach",
         "cruise",
+        "follow",
         "total",
     }
     assert terms["total"] == pytest.approx(reward)
