@@ -122,7 +122,6 @@ def test_stop_reward_terms_only_hold_the_stop_term():
         "brake": 0.0,
         "approach": 0.0,
         "cruise": 0.0,
-        "follow": 0.0,
         "total": -50.0,
     }
 
@@ -189,32 +188,6 @@ def test_passenger_cruise_charges_a_slow_free_road(speed_mps, free, fast, comfor
     assert R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE).cruise == pytest.approx(fast)
     assert R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE).cruise == pytest.approx(comfort)
     assert R.reward_terms(Command.FAST, f).cruise == 0.0  # the paper's reward has no such term
-
-
-@pytest.mark.parametrize(
-    ("speed_mps", "gap_m", "closing_mps", "virtual", "free", "fast"),
-    [
-        # 5 m/s behind a 10 m/s leader 30 m ahead (more than 2 + 2 x 10 = 22 m): the pace
-        # is the leader's speed capped at 90 % of the 10 m/s limit, 9 m/s
-        (5.0, 30.0, -5.0, False, False, -3 * (9.0 - 5.0) / 10.0),
-        (5.0, 30.0, -3.0, False, False, -3 * (8.0 - 5.0) / 10.0),  # leader at 8 m/s
-        (5.0, 20.0, -5.0, False, False, 0.0),  # within 22 m: close enough behind it
-        (5.0, 30.0, 1.0, False, False, 0.0),  # a slower leader sets no pace above the car's
-        (5.0, 30.0, -5.0, True, False, 0.0),  # a stop line is no vehicle to follow
-        (5.0, 60.0, -5.0, False, True, 0.0),  # a free road: cruise's, not follow's
-        (5.0, math.inf, 0.0, False, False, 0.0),  # nothing ahead
-    ],
-)
-def test_passenger_follow_charges_falling_behind_a_faster_leader(
-    speed_mps, gap_m, closing_mps, virtual, free, fast
-):
-    f = _features(
-        speed_mps=speed_mps, limit_mps=10.0, leader_gap_m=gap_m, closing_speed_mps=closing_mps,
-        leader_virtual=virtual, free_road=free,
-    )  # fmt: skip
-    assert R.reward_terms(Command.FAST, f, R.PASSENGER_RECIPE).follow == pytest.approx(fast)
-    assert R.reward_terms(Command.COMFORT, f, R.PASSENGER_RECIPE).follow == 0.0  # fast only
-    assert R.reward_terms(Command.FAST, f).follow == 0.0  # nor the paper's reward
 
 
 def test_needed_deceleration():

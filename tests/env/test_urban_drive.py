@@ -211,7 +211,6 @@ def test_info_carries_the_reward_terms(make_env):
         "brake",
         "approach",
         "cruise",
-        "follow",
         "total",
     }
     assert terms["total"] == pytest.approx(reward)

@@ -25,9 +25,6 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
   yellow ahead calls for the gentlest deceleration that stops at the line, not a harder one;
 * driving below 90 % of the limit on a free road is charged (``cruise``): on an open road a
   passenger expects the car to go;
-* under fast, falling behind a vehicle that drives away is charged (``follow``): a real
-  leader more than :data:`FOLLOW_TIME_GAP_S` ahead that is faster than the car sets the pace,
-  up to 90 % of the limit, so that the car keeps up with the traffic it follows;
 * comfort's progress is worth as much as fast's: the two differ in smoothness.
 """
 
@@ -61,7 +58,6 @@ APPROACH_FREE_DECEL_MPS2 = 1.5  # [m/s^2] ``approach`` charges no stop needing u
 APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
 MAX_NEEDED_MPS2 = 9.0  # [m/s^2] SUMO's emergency braking: ``approach`` charges no further
 CRUISE_SHARE = 0.9  # of the posted limit: ``cruise`` charges free-road driving below it
-FOLLOW_TIME_GAP_S = 2.0  # [s] ``follow`` charges no car closer behind its leader than this
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,8 +80,6 @@ class RewardWeights:
             clear of a vehicle ahead besides :data:`APPROACH_STANDSTILL_M` (not of a stop
             line).
         cruise: weight of -(:data:`CRUISE_SHARE` - v / v_lim) on a free road below it.
-        follow: weight of -(min(v_leader, :data:`CRUISE_SHARE` v_lim) - v) / v_lim behind a
-            faster real leader with room to close in (:func:`follow_penalty`).
         signal_stop: paid per step standing for a light or a pedestrian.
         stop_window_m: ``(min, max)`` distance to the line within which ``signal_stop`` is
             paid; ``None`` pays it at any distance (the paper).
@@ -102,7 +96,6 @@ class RewardWeights:
     approach_free_mps2: float = APPROACH_FREE_DECEL_MPS2
     approach_time_gap_s: float = 0.0
     cruise: float = 0.0
-    follow: float = 0.0
     signal_stop: float = R_RESPECT
     stop_window_m: tuple[float, float] | None = None
 
@@ -172,7 +165,6 @@ PASSENGER_RECIPE = RewardRecipe(
         approach=0.3,
         approach_time_gap_s=1.0,
         cruise=3.0,
-        follow=3.0,
         signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
     ),
@@ -305,24 +297,6 @@ def cruise_penalty(speed_mps: float, limit_mps: float, free_road: bool, weight: 
     return -weight * max(0.0, CRUISE_SHARE - speed_mps / limit_mps)
 
 
-def follow_penalty(
-    speed_mps: float,
-    limit_mps: float,
-    gap_m: float,
-    leader_speed_mps: float,
-    weight: float,
-) -> float:
-    """-weight * (min(v_leader, :data:`CRUISE_SHARE` v_lim) - v) / v_lim when a real leader
-    ``gap_m`` ahead is faster than the car and farther than the standstill gap plus
-    :data:`FOLLOW_TIME_GAP_S` at the leader's speed; else 0 (no leader: ``gap_m`` inf)."""
-    if limit_mps <= 0.0 or not math.isfinite(gap_m):
-        return 0.0
-    if gap_m <= APPROACH_STANDSTILL_M + FOLLOW_TIME_GAP_S * leader_speed_mps:
-        return 0.0
-    pace = min(leader_speed_mps, CRUISE_SHARE * limit_mps)
-    return -weight * max(0.0, pace - speed_mps) / limit_mps
-
-
 def collision_reward(collided: bool) -> float:
     """-r_critical on a collision."""
     return -R_CRITICAL if collided else 0.0
@@ -373,7 +347,6 @@ class RewardTerms:
     brake: float = 0.0
     approach: float = 0.0
     cruise: float = 0.0
-    follow: float = 0.0
 
     @property
     def total(self) -> float:
@@ -430,13 +403,4 @@ def reward_terms(
             w.approach_free_mps2,
         ),
         cruise=cruise_penalty(f.speed_mps, f.limit_mps, f.free_road, w.cruise),
-        follow=_follow(w, f),
     )
-
-
-def _follow(w: RewardWeights, f: StepFeatures) -> float:
-    """The ``follow`` term: behind a real leader only, not on a free road."""
-    if w.follow == 0.0 or f.leader_virtual or f.free_road:
-        return 0.0
-    leader_speed = f.speed_mps - f.closing_speed_mps
-    return follow_penalty(f.speed_mps, f.limit_mps, f.leader_gap_m, leader_speed, w.follow)
