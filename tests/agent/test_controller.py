@@ -217,6 +217,21 @@ def test_after_begin_a_network_trained_on_the_estimate_sees_it(tmp_path: Path) -
     assert seen.speeds == [5.0]
 
 
+def test_the_estimate_knows_the_speed_limiter_cut_its_rise(tmp_path: Path) -> None:
+    """With the speed limiter, +1 m/s from 1 m/s under a 1.5 m/s limit lands on 1.5: the
+    estimate predicts 1.5, not 2.0, and a reading of 1.5 leaves it there."""
+    card = {"mode": "fast", "config": {"speed_estimate": True, "speed_limiter": True}}
+    seen = _Seen(QPolicy.load(helpers.constant_policy(tmp_path / "up.pt", 4, card)))  # +1 m/s
+    ctrl = MergedController(seen, seen, use_shield=False)
+    ctrl.begin(0.6)
+    for reading in (0.0, 1.0, 1.5, 1.5):
+        obs = OBS.copy()
+        obs[1], obs[2] = reading, 1.5
+        ctrl.act(obs)
+    # 0 at rest, then 1.0 (the readings agree with the prediction), then the limit twice
+    assert seen.speeds == pytest.approx([0.0, 1.0, 1.5, 1.5], abs=1e-6)
+
+
 def test_a_network_trained_on_the_readings_keeps_them(tmp_path: Path) -> None:
     plain = _Seen(QPolicy.load(constant_policy(tmp_path, "plain", 4)))  # a card without it
     card = {"mode": "comfort", "config": {"speed_estimate": True}}

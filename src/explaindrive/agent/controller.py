@@ -21,10 +21,10 @@ from explaindrive.agent.estimator import SpeedEstimator
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
-from explaindrive.env.actions import speed_change
+from explaindrive.env.actions import limited_change, speed_change
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.env.metrics import stop_latency_bound
-from explaindrive.env.state import CMD, STATE_DIM, V_EGO
+from explaindrive.env.state import CMD, STATE_DIM, V_EGO, V_LIM
 
 log = logging.getLogger(__name__)
 
@@ -137,7 +137,7 @@ class MergedController:
         speed estimate in place of the reading for a network trained on it."""
         self._stop_steps_left: int | None = None  # under STOP: steps left to a standstill
         self.estimator: SpeedEstimator | None = None
-        self._last_change: int | None = None
+        self._last_change: float | None = None
         self.set_command(command)
 
     def begin(self, speed_noise_sd_mps: float = 0.0) -> None:
@@ -237,10 +237,11 @@ class MergedController:
     def act(self, obs: np.ndarray) -> int:
         """Action of the active agent for a raw observation under the current command."""
         x = self.observation(obs)
+        speed = float(x[V_EGO])
         if self.estimator is not None:  # tracks the speed whichever network drives
-            estimate = self.estimator.update(float(x[V_EGO]), self._last_change)
+            speed = self.estimator.update(speed, self._last_change)
             if self.policy.speed_estimate:
-                x[V_EGO] = estimate
+                x[V_EGO] = speed
         self.last_seen = x
         steps_left = None
         if self.command is Command.STOP:
@@ -255,7 +256,9 @@ class MergedController:
         self.last_override = decision.overridden
         self.overrides += int(decision.overridden)
         action = decision.action if self.use_shield else self.last_network_action
-        self._last_change = speed_change(action)
+        # the change the car commands: through its speed limiter, at the speed it knows
+        limit = float(x[V_LIM]) if self.policy.speed_limiter else None
+        self._last_change = limited_change(speed, speed_change(action), limit)
         return action
 
 
