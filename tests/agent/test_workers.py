@@ -20,7 +20,7 @@ from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.rollout import CollectRequest, RolloutWorker
 from explaindrive.agent.schedule import plan_episode
 from explaindrive.agent.workers import InProcessPool, ProcessPool, make_pool
-from explaindrive.env.actions import speed_change
+from explaindrive.env.actions import limited_change, speed_change
 from tests.agent.fake_drive_env import FakeDriveEnv
 
 CONFIG = preset("safe").replace(hidden_sizes=[8], n_step=3, num_envs=2, episodes=10)
@@ -175,6 +175,38 @@ def test_with_speed_estimate_the_network_learns_from_the_controller_s_estimate()
     assert [float(t.obs[1]) for t in rollout.transitions] != pytest.approx(
         worker.env.readings[:5], abs=1e-3
     )
+
+
+class _LimitedSpeedometer(_NoisySpeedometer):
+    """The same under a 1.5 m/s limit with the speed limiter: a rise past it lands on it."""
+
+    def _obs(self) -> np.ndarray:
+        obs = super()._obs()
+        obs[2] = 1.5
+        return obs
+
+    def step(self, action: int):  # type: ignore[no-untyped-def]
+        v = self.v
+        _, reward, terminated, truncated, info = FakeDriveEnv.step(self, action)
+        self.v = max(0.0, v + limited_change(v, speed_change(int(action)), 1.5))
+        obs = self._obs()
+        return self._read(obs), reward, terminated, truncated, {**info, "true_obs": obs}
+
+
+def test_under_the_speed_limiter_the_estimate_predicts_the_change_it_let_through() -> None:
+    config = CONFIG.replace(
+        speed_estimate=True, obs_noise_max=(0.0, 0.9), noisy_share=1.0, speed_limiter=True
+    )
+    sd = plan_episode(config, 0).obs_noise[1]
+    worker = RolloutWorker(config, functools.partial(_LimitedSpeedometer, max_steps=5), 0)
+    rollout = worker.collect(CollectRequest(steps=5, epsilon=1.0, weights=_weights(), start=0))
+    est, change, expected = SpeedEstimator(sd), None, []
+    for reading, transition in zip(worker.env.readings, rollout.transitions, strict=False):
+        expected.append(est.update(reading, change))
+        change = limited_change(expected[-1], speed_change(transition.action), 1.5)
+    seen = [float(t.obs[1]) for t in rollout.transitions]
+    assert seen == pytest.approx(expected, abs=1e-6)
+    assert max(seen) < 1.5 + 0.5  # the limiter holds the car at 1.5; the estimate follows
 
 
 _KILLED_PARENT = """
