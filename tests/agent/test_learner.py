@@ -184,7 +184,7 @@ def test_actions_over_the_limit_have_their_own_margin(
 
 def test_the_limit_margin_reads_the_limiter() -> None:
     # +1 at 13 m/s under 13.89: 14 m/s without the limiter (over), 13.89 with it (not over);
-    # at 15 m/s the limiter never brakes: -1 leaves 14, 0..+3 keep 15 (over), -3 and -2 not
+    # at 15 m/s -1 leaves 14 and the limiter slows 0..+3 to 14 (over); -3 and -2 are not
     at_13 = np.asarray([[0.0, 13.0, 13.89, 200.0, 0.0, 200.0, 0.0, 200.0]], dtype=np.float32)
     assert limit_mask(at_13)[0].tolist() == [True] * 4 + [False] * 3
     assert limit_mask(at_13, speed_limiter=True)[0].tolist() == [True] * 7

@@ -29,13 +29,16 @@ def test_a_rise_past_the_limit_lands_on_it() -> None:
     assert limited_speed(12.5, 1, LIMIT) == 13.5  # below the limit: unchanged
     assert limited_speed(LIMIT, 1, LIMIT) == LIMIT  # holds 13.89
     assert limited_speed(12.5, -3, LIMIT) == 9.5  # braking: unchanged
-    assert limited_speed(15.0, 2, LIMIT) == 15.0  # above the limit: it never brakes
+    assert limited_speed(15.0, 2, LIMIT) == 14.0  # above the limit: slows by 1 m/s
+    assert limited_speed(14.2, 0, LIMIT) == LIMIT  # ...down to the limit
+    assert limited_speed(15.0, -1, LIMIT) == 14.0  # braking: unchanged
 
 
 def test_the_change_applied_is_the_one_the_limiter_lets_through() -> None:
     assert limited_change(12.0, 3, LIMIT) == pytest.approx(1.89)  # lands on 13.89
     assert limited_change(LIMIT, 1, LIMIT) == 0.0  # holds the limit
-    assert limited_change(15.0, 2, LIMIT) == 0.0  # above it: keeps the speed
+    assert limited_change(15.0, 2, LIMIT) == -1.0  # above it: slows by 1 m/s
+    assert limited_change(14.2, 0, LIMIT) == pytest.approx(-0.31)  # to the limit
     assert limited_change(12.5, 1, LIMIT) == 1  # within the limit: the action's
     assert limited_change(12.5, -3, LIMIT) == -3  # braking: the action's
     assert limited_change(12.0, 3, None) == 3  # no limiter
@@ -57,9 +60,13 @@ def test_the_mask_judges_the_speed_the_limiter_lands_on() -> None:
     batch = np.stack([_free_road(v) for v in (0.0, 12.5, 13.0, LIMIT, 15.0)])
     rows = [safe_action_mask(x, speed_limiter=True) for x in batch]
     assert (safe_action_mask(batch, speed_limiter=True) == np.stack(rows)).all()
-    # above the limit the limiter does not brake: only -3 (12 m/s) and -2 (13 m/s) are back
-    # within it; -1 leaves 14 m/s and a rise keeps 15 m/s
+    # above the limit only -3 (12 m/s) and -2 (13 m/s) are back within it; -1 leaves
+    # 14 m/s and so does a keep or a rise, which the limiter slows by 1 m/s
     assert runtime_mask(_free_road(15.0), speed_limiter=True).tolist() == [True] * 2 + [False] * 5
+    # at 14.2 m/s (an estimate just above the limit) a keep or a rise lands on 13.89, so
+    # every action stays within the limit; without the limiter only the brakings do
+    assert runtime_mask(_free_road(14.2), speed_limiter=True).tolist() == [True] * 7
+    assert runtime_mask(_free_road(14.2)).tolist() == [True] * 3 + [False] * 4
     # the shield keeps the fastest change at 13 m/s only with the limiter
     fastest = np.arange(7, dtype=np.float64)
     assert shield(_free_road(13.0), fastest).action == action_index(0)

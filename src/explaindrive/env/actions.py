@@ -3,8 +3,11 @@
 With the speed limiter (Intelligent Speed Assistance, as new cars in the EU carry it; the
 ``passenger`` preset's ``speed_limiter``), a rise that would pass the posted limit lands on
 the limit instead (:func:`limited_speed`): whole-m/s changes can then hold 13.89 m/s. It
-never brakes: a car already above the limit keeps its speed on a rise. The ``paper`` preset
-keeps the paper's dynamics (no limiter); speeding is judged on the true speed either way.
+does not brake, but above the limit (past a sign of a lower one) it cuts the throttle: a car
+that keeps or raises its speed there slows by :data:`LIMITER_COAST_MPS` a step, down to the
+limit. So a car held at the limit whose speed estimate reads a little above it is not made to
+brake. The ``paper`` preset keeps the paper's dynamics (no limiter); speeding is judged on the
+true speed either way.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ IDLE_ACTION = SPEED_CHANGES_MPS.index(0)
 MAX_BRAKE_MPS = -min(SPEED_CHANGES_MPS)  # [m/s per step] the strongest braking action
 STOP_MARGIN_M = 2.0  # [m] the gap a car braking hardest keeps before where it must stand
 SPEEDS_KEPT = 1024  # speeds whose results the one-speed helpers keep
+LIMITER_COAST_MPS = 1.0  # [m/s per step] above the limit the limiter's throttle cut slows by
 
 
 def speed_change(action: object) -> int:
@@ -51,22 +55,24 @@ def action_index(change_mps: int) -> int:
 
 def limited_speed(v_mps: float, change_mps: float, limit_mps: float | None) -> float:
     """[m/s] The speed after a change of ``change_mps`` from ``v_mps``, clipped at 0; with a
-    posted limit ``limit_mps`` (the speed limiter on), a rise that would pass it lands on it,
-    or keeps the speed when that is above it (``None``: no limiter)."""
+    posted limit ``limit_mps`` (the speed limiter on), a change that is not a braking and
+    would end above the limit lands on it, or, from above it, :data:`LIMITER_COAST_MPS`
+    lower but not below it (``None``: no limiter)."""
     v_new = max(0.0, v_mps + change_mps)
-    if limit_mps is not None and change_mps > 0 and v_new > limit_mps:
-        return max(v_mps, limit_mps)
+    if limit_mps is not None and change_mps >= 0 and v_new > limit_mps:
+        return max(limit_mps, v_mps - LIMITER_COAST_MPS)
     return v_new
 
 
 def limited_change(v_mps: float, change_mps: int, limit_mps: float | None) -> float:
     """[m/s] The speed change the speed limiter lets through of ``change_mps`` at ``v_mps``:
-    the change itself, except a rise that would pass ``limit_mps`` becomes ``limit - v``
-    (0 when ``v`` is already above it). ``None``: no limiter, the change itself. The clip at
+    the change itself, except that one that is not a braking and would end above
+    ``limit_mps`` becomes ``limit - v``, at least ``-LIMITER_COAST_MPS`` (:func:`limited_speed`).
+    ``None``: no limiter, the change itself. The clip at
     standstill is not the limiter's and is not applied here (braking from 1 m/s by 3 m/s
     stays -3)."""
-    if limit_mps is not None and change_mps > 0 and v_mps + change_mps > limit_mps:
-        return max(0.0, limit_mps - v_mps)
+    if limit_mps is not None and change_mps >= 0 and v_mps + change_mps > limit_mps:
+        return max(limit_mps - v_mps, -LIMITER_COAST_MPS)
     return change_mps
 
 

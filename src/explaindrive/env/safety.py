@@ -10,7 +10,8 @@ An action is safe when, after it, the ego could still stop braking at -3 m/s per
 
 With the speed limiter (``speed_limiter=True``, the ``passenger`` preset's;
 :func:`~explaindrive.env.actions.limited_speed`) an action is judged by the speed it lands
-on: a rise that would pass the limit lands on it, so it does not exceed the limit.
+on: a rise that would pass the limit lands on it, so it does not exceed the limit, and above
+the limit keeping or raising the speed slows the car by 1 m/s, down to the limit.
 
 Standing still after the step is safe with respect to every stop line and leader.
 
@@ -43,6 +44,7 @@ from numpy.typing import NDArray
 from explaindrive.commands import Command
 from explaindrive.env import state as S
 from explaindrive.env.actions import (
+    LIMITER_COAST_MPS,
     MAX_BRAKE_MPS,
     SPEED_CHANGES_MPS,
     SPEEDS_KEPT,
@@ -86,13 +88,15 @@ class ActionOutcomes(NamedTuple):
 
 
 def action_outcomes(
-    speed_mps: NDArray[np.float64] | float, cap_mps: NDArray[np.float64] | float = math.inf
+    speed_mps: NDArray[np.float64] | float, limit_mps: NDArray[np.float64] | float = math.inf
 ) -> ActionOutcomes:
-    """The :class:`ActionOutcomes` of speeds of shape ``(B, 1)``, or of one speed; rises
-    stop at ``cap_mps`` (the speed limiter's ``max(v, limit)``; ``inf``: no limiter)."""
+    """The :class:`ActionOutcomes` of speeds of shape ``(B, 1)``, or of one speed, through
+    the speed limiter at ``limit_mps`` (:func:`~explaindrive.env.actions.limited_speed`;
+    ``inf``: no limiter)."""
     v = speed_mps
     v_new = np.maximum(v + _CHANGES, 0.0)
-    v_new = np.where(_CHANGES > 0, np.minimum(v_new, cap_mps), v_new)
+    limited = (_CHANGES >= 0) & (v_new > limit_mps)
+    v_new = np.where(limited, np.maximum(limit_mps, v - LIMITER_COAST_MPS), v_new)
     return ActionOutcomes(
         v_new=v_new,
         need=stopping_needs(v_new),
@@ -159,8 +163,8 @@ def _columns(
     :class:`ActionOutcomes` of their speeds (through the speed limiter with ``limiter``)."""
     rows = x.reshape(-1, S.STATE_DIM)
     v = rows[:, S.V_EGO : S.V_EGO + 1]
-    cap = np.maximum(v, rows[:, S.V_LIM : S.V_LIM + 1]) if limiter else math.inf
-    return tuple(rows.T[:, :, None]), action_outcomes(v, cap)
+    limit = rows[:, S.V_LIM : S.V_LIM + 1] if limiter else math.inf
+    return tuple(rows.T[:, :, None]), action_outcomes(v, limit)
 
 
 def _unsafe(
@@ -235,10 +239,10 @@ class _Action(NamedTuple):
 
 
 @lru_cache(maxsize=SPEEDS_KEPT)
-def _actions_at(speed_mps: float, cap_mps: float = math.inf) -> tuple[tuple[_Action, ...], float]:
-    """The 7 actions' outcomes at one speed (rises stopping at ``cap_mps``) and
+def _actions_at(speed_mps: float, limit_mps: float = math.inf) -> tuple[tuple[_Action, ...], float]:
+    """The 7 actions' outcomes at one speed (through the speed limiter at ``limit_mps``) and
     ``least_need``, kept per speed (the speeds of an episode repeat)."""
-    o = action_outcomes(speed_mps, cap_mps)
+    o = action_outcomes(speed_mps, limit_mps)
     columns = (o.v_new, o.need, o.slows, o.keeps, o.closer, o.eases)
     actions = tuple(_Action(*row) for row in zip(*(c.tolist() for c in columns), strict=True))
     return actions, float(o.least_need)
@@ -257,7 +261,7 @@ def _unsafe_one(
     nearest busy crossing, light to stop for and point where the real leader could stop.
     ``limiter``: the speed limiter is on."""
     cmd, v, v_lim, gap, dv, d_tl, tls, d_cross = values
-    actions, least_need = _actions_at(v, max(v, v_lim) if limiter else math.inf)
+    actions, least_need = _actions_at(v, v_lim if limiter else math.inf)
     room = d_cross if d_cross < S.SENSOR_RANGE_M else math.inf
     tls = _code(tls)
     signal = tls != 0
@@ -288,7 +292,7 @@ def limit_mask(obs: NDArray[np.floating], speed_limiter: bool = False) -> NDArra
     if x.ndim == 1:
         values = x.tolist()
         v, v_lim = values[S.V_EGO], values[S.V_LIM]
-        actions, _ = _actions_at(v, max(v, v_lim) if speed_limiter else math.inf)
+        actions, _ = _actions_at(v, v_lim if speed_limiter else math.inf)
         return np.array([not a.over(v_lim) for a in actions], dtype=np.bool_)
     columns, outcomes = _columns(x.astype(np.float64, copy=False), speed_limiter)
     return ~_over_limit(columns[S.V_LIM], outcomes)

@@ -313,8 +313,8 @@ class UrbanDriveEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def _advance(self, ep: Episode, change: int, posted_limit_mps: float) -> Motion:
         """Set the ego's speed (or let SUMO drive it), simulate one step, read the outcome.
-        With the speed limiter on, a rise that would pass ``posted_limit_mps`` (the limit the
-        agent observed) lands on it."""
+        With the speed limiter on, the speed goes through it at ``posted_limit_mps`` (the
+        limit the agent observed; :func:`~explaindrive.env.actions.limited_speed`)."""
         limit = posted_limit_mps if self.config.speed_limiter else None
         v_new = limited_speed(ep.speed_mps, change, limit)
         agent = self.config.ego_model == "agent"
