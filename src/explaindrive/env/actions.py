@@ -55,9 +55,9 @@ def action_index(change_mps: int) -> int:
 
 def limited_speed(v_mps: float, change_mps: float, limit_mps: float | None) -> float:
     """[m/s] The speed after a change of ``change_mps`` from ``v_mps``, clipped at 0; with a
-    posted limit ``limit_mps`` (the speed limiter on), a change that is not a braking and
-    would end above the limit lands on it, or, from above it, :data:`LIMITER_COAST_MPS`
-    lower but not below it (``None``: no limiter)."""
+    posted limit ``limit_mps`` (the speed limiter on), a keep or a rise that would end above
+    the limit lands on it, or, from above it, :data:`LIMITER_COAST_MPS` lower but not below
+    it (``None``: no limiter)."""
     v_new = max(0.0, v_mps + change_mps)
     if limit_mps is not None and change_mps >= 0 and v_new > limit_mps:
         return max(limit_mps, v_mps - LIMITER_COAST_MPS)
@@ -66,8 +66,8 @@ def limited_speed(v_mps: float, change_mps: float, limit_mps: float | None) -> f
 
 def limited_change(v_mps: float, change_mps: int, limit_mps: float | None) -> float:
     """[m/s] The speed change the speed limiter lets through of ``change_mps`` at ``v_mps``:
-    the change itself, except that one that is not a braking and would end above
-    ``limit_mps`` becomes ``limit - v``, at least ``-LIMITER_COAST_MPS`` (:func:`limited_speed`).
+    the change itself, except that a keep or a rise that would end above ``limit_mps``
+    becomes ``limit - v``, but no less than ``-LIMITER_COAST_MPS`` (:func:`limited_speed`).
     ``None``: no limiter, the change itself. The clip at
     standstill is not the limiter's and is not applied here (braking from 1 m/s by 3 m/s
     stays -3)."""
