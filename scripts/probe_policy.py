@@ -7,12 +7,13 @@ Both probes follow the network's greedy (bare) choice on made-up states, with th
 environment's kinematics: the speed change applies at once and the car covers its new
 speed in the 1 s step.
 
-- Free road, per posted limit: from a standstill with nothing in range, the speed where the
-  network stops accelerating, its share of the limit, the highest whole speed under the
-  limit, and how far Q(+1) lies below the best action at the settled speed. Then, on speeds
-  in steps of 0.1 m/s, the lowest speed from which Q(+1) stays below Q(0) up to the limit:
-  +1 becomes illegal above the limit less 1 m/s, and how far under that the network gives
-  it up shows how far the values pushed down there spread to legal speeds.
+- Free road, per posted limit: from a standstill with nothing in range, the speed where
+  the network stops accelerating (for a network trained with the speed limiter, through
+  it), its share of the limit, the highest whole speed under the limit, and how far Q(+1)
+  lies below the best action at the settled speed. Then, on speeds in steps of 0.1 m/s,
+  the lowest speed from which Q(+1) stays below Q(0) up to the limit: +1 becomes illegal
+  above the limit less 1 m/s, and how far under that the network gives it up shows how far
+  the values pushed down there spread to legal speeds.
 - Red light: from that settled speed, with a red light ``--light-m`` ahead as the leader,
   the approach until the car stands: the distance it stands from the line, its hardest
   braking and how far from the line it starts braking.
@@ -25,7 +26,9 @@ speed in the 1 s step.
   trained on the controller's speed estimate chooses on the estimate instead, whose error
   settles at a smaller deviation (``agent/estimator.py:settled_sd``: 0.17 m/s under 0.6);
   the probe draws its readings with that deviation (independently, where the estimate's
-  errors are correlated from step to step).
+  errors are correlated from step to step). The chain has whole speeds only, so it is not
+  drawn for a network trained with the speed limiter (which lands a rise on the limit and
+  cannot speed by rising): its columns read "-".
 
 - Standing before a red line (50 km/h zone): at a standstill 9, 7 and 5 m before it, the value
   of staying, Q(0), and how far Q(+1), creeping a metre closer, lies from it.
@@ -47,7 +50,7 @@ from explaindrive.agent.controller import QPolicy
 from explaindrive.agent.estimator import settled_sd
 from explaindrive.commands import Command
 from explaindrive.env import state as S
-from explaindrive.env.actions import SPEED_CHANGES_MPS, action_index, speed_change
+from explaindrive.env.actions import SPEED_CHANGES_MPS, action_index, limited_speed, speed_change
 
 LIMITS_KMH = (30, 40, 50, 60, 70)
 
@@ -59,15 +62,19 @@ def _obs(cmd: int, v: float, limit: float, light_m: float | None) -> np.ndarray:
     return np.asarray([cmd, v, limit, d, dv, d, float(tls), S.SENSOR_RANGE_M], np.float32)
 
 
-def free_road(policy: QPolicy, cmd: int, limit: float) -> tuple[float, float]:
-    """The speed the network settles at from a standstill, and Q(+1) - max Q there."""
+def free_road(
+    policy: QPolicy, cmd: int, limit: float, limiter: bool = False
+) -> tuple[float, float]:
+    """The speed the network settles at from a standstill (through the speed limiter with
+    ``limiter``), and Q(+1) - max Q there."""
     v = 0.0
     for _ in range(40):
         q = policy.q_values(_obs(cmd, v, limit, None))
         change = speed_change(int(np.argmax(q)))
-        if change <= 0:
+        v_new = min(limited_speed(v, change, limit if limiter else None), S.MAX_SPEED_MPS)
+        if change <= 0 or v_new == v:
             return v, float(q[action_index(1)] - q.max())
-        v = min(v + change, S.MAX_SPEED_MPS)
+        v = v_new
     return v, math.nan
 
 
@@ -84,17 +91,18 @@ def gives_up_plus_one(policy: QPolicy, cmd: int, limit: float) -> float:
 
 
 def red_light(
-    policy: QPolicy, cmd: int, limit: float, speed: float, light_m: float
+    policy: QPolicy, cmd: int, limit: float, speed: float, light_m: float, limiter: bool = False
 ) -> tuple[float, int, float]:
     """From ``speed``, ``light_m`` before a red line: the distance the car stands from it,
-    its hardest braking [m/s per step] and how far from the line it first brakes."""
+    its hardest braking [m/s per step] and how far from the line it first brakes (through
+    the speed limiter with ``limiter``)."""
     v, d = speed, light_m
     hardest, first_brake, still = 0, math.nan, 0
     for _ in range(200):
         change = speed_change(int(np.argmax(policy.q_values(_obs(cmd, v, limit, d)))))
         if change < 0 and math.isnan(first_brake):
             first_brake = d
-        v_new = max(v + change, 0.0)
+        v_new = limited_speed(v, change, limit if limiter else None)
         hardest = min(hardest, round(v_new - v))
         v = v_new
         d -= v
@@ -161,15 +169,19 @@ def main() -> None:
         cmd = int(Command.parse(policy.card["mode"]))
         for kmh in LIMITS_KMH:
             limit = kmh / 3.6
-            settled, gap = free_road(policy, cmd, limit)
+            limiter = policy.speed_limiter
+            settled, gap = free_road(policy, cmd, limit, limiter)
             gives_up = gives_up_plus_one(policy, cmd, limit)
-            stand, hardest, first = red_light(policy, cmd, limit, settled, args.light_m)
-            seen_sd = settled_sd(sd) if policy.speed_estimate else sd
-            mean, over = noisy_cruise(policy, cmd, limit, settled, seen_sd, args.draws)
+            stand, hardest, first = red_light(policy, cmd, limit, settled, args.light_m, limiter)
+            noisy = "- | -"
+            if not limiter:
+                seen_sd = settled_sd(sd) if policy.speed_estimate else sd
+                mean, over = noisy_cruise(policy, cmd, limit, settled, seen_sd, args.draws)
+                noisy = f"{mean:.2f} | {over:.2f}"
             print(
-                f"| {path} | {kmh} | {settled:.0f} | {settled / limit:.2f} | "
+                f"| {path} | {kmh} | {settled:.4g} | {settled / limit:.2f} | "
                 f"{math.floor(limit)} | {gap:.1f} | {gives_up:.1f} | {first:.0f} | {hardest} | "
-                f"{stand:.1f} | {mean:.2f} | {over:.2f} |"
+                f"{stand:.1f} | {noisy} |"
             )
     metres = " / ".join(f"{d:.0f}" for d in STANDSTILL_M)
     print(f"\n| policy | standing {metres} m before a red line: Q(0) | Q(+1) - Q(0) |")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from types import ModuleType, SimpleNamespace
 
+import numpy as np
 import pytest
 import torch
 
@@ -47,3 +48,22 @@ def test_noise_lets_a_reading_under_the_threshold_take_the_car_over() -> None:
     # speed 13 is over a 12.9 limit; there a reading under 12 (1.67 sd at 0.6) still climbs.
     mean, over = _probe().noisy_cruise(_threshold(12.0), 1, 12.9, 12.0, 0.6, draws=20_000)
     assert mean > 12.5 and over > 900
+
+
+def _always_up() -> SimpleNamespace:
+    """A driver that always asks for +1 m/s."""
+
+    def q_values(obs: np.ndarray) -> np.ndarray:
+        q = np.zeros(7)
+        q[action_index(1)] = 1.0
+        return q
+
+    return SimpleNamespace(q_values=q_values)
+
+
+def test_through_the_limiter_a_driver_that_always_rises_settles_on_the_limit():
+    probe = _probe()
+    settled, gap = probe.free_road(_always_up(), 1, 13.89, limiter=True)
+    assert settled == pytest.approx(13.89) and gap == 0.0  # +1 is its best action there
+    # without the limiter it climbs by 1 m/s a step to the top of the speed range
+    assert probe.free_road(_always_up(), 1, 13.89)[0] == S.MAX_SPEED_MPS
