@@ -15,6 +15,7 @@ from explaindrive.language.data import (
     DECISIONS_JSONL,
     HELDOUT_CSV,
     LABELLED_CSVS,
+    NEXT_HELDOUT_CSV,
     TEST_CSV,
     TRAIN_CSV,
     data_path,
@@ -96,6 +97,21 @@ def test_the_test_split_and_which_of_its_lines_have_a_near_copy_learned_from() -
     assert near_copies(unseen, seen) == set()
     near = [r.text for r in heldout if r.split == NEAR_SPLIT]
     assert near_copies(seen, near[:5]) == set(near[:5])
+
+
+def test_the_next_test_split_is_apart_from_every_labelled_line() -> None:
+    """The split the next model is scored on: the layout of the test split, and its
+    ``unseen`` lines near no labelled line (the everyday pool was checked too when it was
+    committed); a line that is also a labelled one ("Absolutely.") is marked ``near``."""
+    nxt = load_commands(data_path(NEXT_HELDOUT_CSV))
+    assert Counter(r.label for r in nxt) == {"fast": 100, "comfort": 100, "stop": 100, "none": 270}
+    negated = [r for r in nxt if r.kind == "negated_stop"]
+    assert len(negated) == 45 and {r.label for r in negated} == {"none"}
+    assert Counter(r.kind for r in nxt if r.label == "stop")["park"] == 20
+    seen = [r["text"] for name in LABELLED_CSVS for r in read_lines(data_path(name))]
+    unseen = [r.text for r in nxt if r.split == UNSEEN_SPLIT]
+    assert len(unseen) == 281 and {r.split for r in nxt} == {UNSEEN_SPLIT, NEAR_SPLIT}
+    assert near_copies(unseen, seen) == set()
 
 
 def test_near_copies_either_way_round() -> None:

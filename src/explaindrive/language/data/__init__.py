@@ -34,6 +34,11 @@ HELDOUT_CSV = "commands_heldout10.csv"
 before any model was run on it, scored once. Its column ``split`` says whether a line had a
 near-copy among the lines a model learns or is calibrated from when it was committed
 (``near``) or not (``unseen``)."""
+NEXT_HELDOUT_CSV = "commands_heldout11.csv"
+"""The next test split: written by an author who saw neither the data nor the models and
+committed before any model was run on it, in the layout of :data:`HELDOUT_CSV`. No model is
+trained, calibrated or selected on it; the next fine-tuned model is scored on it once, and it
+then takes the place of :data:`HELDOUT_CSV`."""
 FORMER_HELDOUT_CSVS = (
     "commands_heldout.csv",
     "commands_heldout2.csv",
