@@ -247,3 +247,23 @@ def test_a_network_trained_on_the_readings_keeps_them(tmp_path: Path) -> None:
     # the estimate runs under both: +1, +1 from rest -> about 2 m/s when comfort takes over
     assert plain.speeds == [0.5, 1.6]
     assert estimating.speeds[0] == pytest.approx(2.0, abs=0.02)
+
+
+def test_the_car_has_the_limiter_when_either_network_was_trained_with_it(tmp_path: Path) -> None:
+    """A fast network trained with the limiter and a comfort one trained without it: the
+    car drives with the limiter under both, so the comfort network's estimate, too,
+    predicts the rise the limiter lets through (1.5 from 1.0 under a 1.5 m/s limit)."""
+    card = {"mode": "fast", "config": {"speed_estimate": True, "speed_limiter": True}}
+    fast = QPolicy.load(helpers.constant_policy(tmp_path / "fast.pt", 4, card))
+    plain_card = {"mode": "comfort", "config": {"speed_estimate": True}}
+    comfort = _Seen(QPolicy.load(helpers.constant_policy(tmp_path / "c.pt", 4, plain_card)))
+    assert fast.speed_limiter and not comfort.speed_limiter
+    ctrl = MergedController(fast, comfort, command="comfort", use_shield=False)
+    assert ctrl.speed_limiter
+    assert not MergedController(comfort, comfort).speed_limiter
+    ctrl.begin(0.6)
+    for reading in (0.0, 1.0, 1.5, 1.5):
+        obs = OBS.copy()
+        obs[1], obs[2] = reading, 1.5
+        ctrl.act(obs)
+    assert comfort.speeds == pytest.approx([0.0, 1.0, 1.5, 1.5], abs=1e-6)
