@@ -7,7 +7,8 @@
 For every collision, red-light run or pedestrian-yield violation it prints the last
 ``--before`` steps: the time and the ego's route position, the observation, the
 network's speed change, and the actions that the learning mask (the shipped recipe's)
-and the run-time shield allow (one digit per action, -3 ... +3 m/s). With ``--obs-noise``
+and the run-time shield allow (one digit per action, -3 ... +3 m/s; for a network trained
+with the speed limiter the episode and both masks run through it). With ``--obs-noise``
 the network sees a noisy observation, as ``explaindrive evaluate --obs-noise`` has it (a
 network trained on the speed estimate sees the estimate in place of the speed reading, and
 the row shows it); each step then shows the true state on a second line. With
@@ -88,6 +89,7 @@ def main() -> None:
         config=EnvConfig(
             traffic_level=args.traffic,
             yellow_leader=agent.yellow_leader,
+            speed_limiter=agent.speed_limiter,
             obs_noise=(noise.sd_m, noise.sd_mps),
             **({"scenario": args.scenario} if args.scenario else {}),
             **_own_network(args),
@@ -111,8 +113,10 @@ def main() -> None:
                 seen[V_EGO] = driver.estimator.speed_mps or 0.0  # the estimate it acted on
             cells = [f"{env.time_s:.0f}s {env.route_pos_m:.1f}"]
             cells += [f"{x:.1f}" for x in seen]
-            cells += [f"{speed_change(action):+d}", _bits(training_mask(seen)),
-                      _bits(runtime_mask(seen))]  # fmt: skip
+            limiter = agent.speed_limiter
+            cells += [f"{speed_change(action):+d}",
+                      _bits(training_mask(seen, speed_limiter=limiter)),
+                      _bits(runtime_mask(seen, limiter))]  # fmt: skip
             if "true_obs" in info:
                 cells += ["\n  true\t", *(f"{x:.1f}" for x in info["true_obs"])]
             recent.append("\t".join(cells))
