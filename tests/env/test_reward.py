@@ -222,23 +222,6 @@ def test_standing_for_a_signal_pays_only_near_the_line(gap_m, paper, passenger):
     assert t.total == pytest.approx(passenger - 0.5)  # and the charge for time
 
 
-@pytest.mark.parametrize(
-    ("gap_m", "leader_mps", "passenger"),
-    [(10.0, 0.0, 0.0), (10.0, 1.0, 0.0), (10.0, 1.1, -10.0), (5.0, 3.0, 0.0), (5.1, 3.0, -10.0)],
-)
-def test_a_car_driving_off_ahead_is_no_reason_to_stand(gap_m, leader_mps, passenger):
-    """Standing behind a real vehicle 10 m ahead: justified while it stands or creeps at up
-    to 1 m/s; once it drives off faster, only within 5 m of it (it has just started). The
-    paper's reward justifies standing behind any vehicle within 15 m."""
-    f = _features(
-        speed_mps=0.0, speed_change_mps=0, ttc_s=math.inf, headway_s=math.inf, jerk_mps3=0.0,
-        stop_reason="queue", leader_gap_m=gap_m, closing_speed_mps=-leader_mps,
-    )  # fmt: skip
-    assert R.reward_terms(Command.FAST, f).traffic == 0.0
-    for command in (Command.FAST, Command.COMFORT):
-        assert R.reward_terms(command, f, R.PASSENGER_RECIPE).traffic == passenger
-
-
 @pytest.mark.parametrize(("gap_m", "paid"), [(4.5, 0.0), (4.0, 2.0), (1.0, 2.0), (0.9, 0.0)])
 def test_a_stop_window_replaces_the_recipes_under_both_commands(gap_m, paid):
     recipe = R.PASSENGER_RECIPE.with_stop_window((1, 4))

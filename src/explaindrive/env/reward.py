@@ -13,10 +13,6 @@ The ``passenger`` recipe keeps every term and changes weights and where they app
 * a charge per step for time (``time``), so that getting there pays;
 * standing for a light or a pedestrian pays only within 1-5 m of the line, and less than
   driving (``signal_stop``, ``stop_window_m``);
-* a car close ahead justifies standing only while it stands too: once it drives off faster
-  than 1 m/s and more than :data:`QUEUE_STANDSTILL_GAP_M` ahead, standing behind it is
-  standing without a reason (``queue_leader_mps``), so that the car moves off in a queue as
-  the one in front does and not once the gap has grown to 15 m;
 * jerk is charged under fast too (lightly), and braking harder than 1 m/s^2 is charged
   (``hard_brake``), more under comfort;
 * closing in on a leader, a red light or a pedestrian too fast to stop gently is charged
@@ -57,7 +53,6 @@ COMFORT_CF_WEIGHTS = (2.0, 1.5)
 FAST_SPEED_WEIGHT = 3.0
 COMFORT_SPEED_WEIGHT = 1.5
 STOP_REASON_GAP_M = 15.0  # [m] a leader this close justifies standing still
-QUEUE_STANDSTILL_GAP_M = 5.0  # [m] standing this close behind a car that drives off is no fault
 GENTLE_BRAKE_MPS2 = 1.0  # [m/s^2] braking up to this is not charged by ``hard_brake``
 APPROACH_FREE_DECEL_MPS2 = 1.5  # [m/s^2] ``approach`` charges no stop needing up to this (default)
 APPROACH_STANDSTILL_M = 2.0  # [m] the approach aims to stand this far behind the obstacle
@@ -88,9 +83,6 @@ class RewardWeights:
         signal_stop: paid per step standing for a light or a pedestrian.
         stop_window_m: ``(min, max)`` distance to the line within which ``signal_stop`` is
             paid; ``None`` pays it at any distance (the paper).
-        queue_leader_mps: a real vehicle within :data:`STOP_REASON_GAP_M` justifies standing
-            only while it drives no faster than this [m/s] or is within
-            :data:`QUEUE_STANDSTILL_GAP_M`; ``None``: whatever its speed (the paper).
     """
 
     ttc: float
@@ -106,7 +98,6 @@ class RewardWeights:
     cruise: float = 0.0
     signal_stop: float = R_RESPECT
     stop_window_m: tuple[float, float] | None = None
-    queue_leader_mps: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -162,7 +153,6 @@ PAPER_RECIPE = RewardRecipe(
     ),
 )
 STOP_WINDOW_M = (1.0, 5.0)  # [m] where a car standing for a light or a pedestrian should stand
-QUEUE_MOVING_MPS = 1.0  # [m/s] a car ahead driving off faster than this is no reason to stand
 PASSENGER_RECIPE = RewardRecipe(
     "passenger",
     fast=RewardWeights(
@@ -177,7 +167,6 @@ PASSENGER_RECIPE = RewardRecipe(
         cruise=3.0,
         signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
-        queue_leader_mps=QUEUE_MOVING_MPS,
     ),
     comfort=RewardWeights(
         *COMFORT_CF_WEIGHTS,
@@ -192,7 +181,6 @@ PASSENGER_RECIPE = RewardRecipe(
         cruise=5.0,
         signal_stop=2.0,
         stop_window_m=STOP_WINDOW_M,
-        queue_leader_mps=QUEUE_MOVING_MPS,
     ),
 )
 StopWindow = Annotated[tuple[float, float], FROM_LIST, AfterValidator(check_stop_window)]
@@ -376,17 +364,6 @@ TERM_NAMES: tuple[str, ...] = tuple(f.name for f in fields(RewardTerms))
 """The names of the :class:`RewardTerms`, in their order."""
 
 
-def _stop_reason(w: RewardWeights, f: StepFeatures) -> str | None:
-    """Why standing still is justified under ``w``: ``f.stop_reason``, except behind a real
-    vehicle that drives off (:attr:`RewardWeights.queue_leader_mps`)."""
-    if f.stop_reason != "queue" or w.queue_leader_mps is None:
-        return f.stop_reason
-    leader_mps = f.speed_mps - f.closing_speed_mps
-    if leader_mps > w.queue_leader_mps and f.leader_gap_m > QUEUE_STANDSTILL_GAP_M:
-        return None
-    return f.stop_reason
-
-
 def _signal_stop(w: RewardWeights, gap_m: float) -> float:
     """What standing for a signal pays at ``gap_m`` before its line."""
     if w.stop_window_m is None:
@@ -411,7 +388,7 @@ def reward_terms(
         traffic=traffic_rules_reward(
             violation=f.violation,
             stopped=f.speed_mps <= 0.0,
-            stop_reason=_stop_reason(w, f),
+            stop_reason=f.stop_reason,
             signal_stop=_signal_stop(w, f.leader_gap_m),
         ),
         speed=speed_reward(f.speed_mps, f.limit_mps, w.speed),
