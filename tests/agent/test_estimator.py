@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from explaindrive.agent.estimator import GATE_SD, SpeedEstimator, settled_sd
+from explaindrive.agent.estimator import GATE_SD, SpeedEstimator, commanded_change, settled_sd
 
 
 def test_without_noise_the_estimate_is_the_reading() -> None:
@@ -79,3 +79,18 @@ def test_on_a_noisy_sensor_the_estimate_is_closer_than_the_readings() -> None:
 def test_bad_deviations_are_refused(sd: float, drift: float) -> None:
     with pytest.raises(ValueError, match="finite number >= 0"):
         SpeedEstimator(sd, drift_mps=drift)
+
+
+@pytest.mark.parametrize(
+    ("speed", "action", "limiter", "change"),
+    [
+        (13.0, 4, True, 13.89 - 13.0),  # +1 under 13.89: the limiter lets 0.89 through
+        (13.0, 4, False, 1.0),  # without it, the whole +1
+        (15.0, 3, True, -1.0),  # a keep above the limit coasts by 1 m/s
+        (15.0, 3, False, 0.0),
+        (10.0, 6, True, 3.0),  # +3 from 10 stays under the limit
+        (1.0, 0, True, -3.0),  # -3 from 1 m/s: the estimate, not the change, stops at 0
+    ],
+)
+def test_the_commanded_change_goes_through_the_cars_limiter(speed, action, limiter, change):
+    assert commanded_change(speed, action, 13.89, limiter) == pytest.approx(change)

@@ -17,11 +17,10 @@ import numpy as np
 import torch
 
 from explaindrive.agent.checkpoint import CheckpointError, load_policy, policy_file
-from explaindrive.agent.estimator import SpeedEstimator
+from explaindrive.agent.estimator import SpeedEstimator, commanded_change
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.shield import shield
 from explaindrive.commands import Command
-from explaindrive.env.actions import limited_change, speed_change
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.env.metrics import stop_latency_bound
 from explaindrive.env.state import CMD, STATE_DIM, V_EGO, V_LIM
@@ -252,9 +251,7 @@ class MergedController:
         self.last_override = decision.overridden
         self.overrides += int(decision.overridden)
         action = decision.action if self.use_shield else self.last_network_action
-        # the change the car commands: through its speed limiter, at the speed it knows
-        limit = float(x[V_LIM]) if limiter else None
-        self._last_change = limited_change(speed, speed_change(action), limit)
+        self._last_change = commanded_change(speed, action, float(x[V_LIM]), limiter)
         return action
 
 

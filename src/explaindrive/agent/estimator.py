@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import math
 
+from explaindrive.env.actions import limited_change, speed_change
+
 SPEED_DRIFT_MPS = 0.05
 """[m/s] Standard deviation of the difference, per 1 s step, between the speed the car was
 told to reach and the speed it reaches (the filter's process noise)."""
@@ -103,3 +105,10 @@ def settled_sd(sd_mps: float, drift_mps: float = SPEED_DRIFT_MPS) -> float:
         return 0.0
     p = (q + math.sqrt(q * q + 4.0 * q * r)) / 2.0
     return math.sqrt(p * r / (p + r))
+
+
+def commanded_change(speed_mps: float, action: int, limit_mps: float, speed_limiter: bool) -> float:
+    """The speed change [m/s] the car commands with ``action`` at the speed it knows, which
+    the estimate predicts with: the action's change, through the speed limiter under the
+    posted limit ``limit_mps`` when the car has one (+1 at 13 m/s under 13.89 m/s: 0.89)."""
+    return limited_change(speed_mps, speed_change(action), limit_mps if speed_limiter else None)

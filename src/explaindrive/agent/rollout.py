@@ -27,12 +27,11 @@ import torch
 
 from explaindrive.agent.buffer import Transition
 from explaindrive.agent.config import TrainConfig
-from explaindrive.agent.estimator import SpeedEstimator
+from explaindrive.agent.estimator import SpeedEstimator, commanded_change
 from explaindrive.agent.learner import D3QNLearner
 from explaindrive.agent.network import DuelingQNetwork
 from explaindrive.agent.schedule import EpisodePlan, plan_episode
 from explaindrive.agent.shield import limit_mask, training_mask
-from explaindrive.env.actions import limited_change, speed_change
 from explaindrive.env.lights import DEFAULT_YELLOW_LEADER
 from explaindrive.env.state import V_EGO, V_LIM
 from explaindrive.sim.scenario.layout import SEED_LIMIT
@@ -338,9 +337,10 @@ class RolloutWorker:
         next_obs, reward, terminated, truncated, info = self.env.step(action)
         next_obs = np.asarray(next_obs, dtype=np.float32)
         next_true = _true_state(next_obs, info)
-        if ep.estimator is not None:  # the change commanded: through the speed limiter
-            limit = float(ep.obs[V_LIM]) if self.config.speed_limiter else None
-            change = limited_change(float(ep.obs[V_EGO]), speed_change(action), limit)
+        if ep.estimator is not None:
+            change = commanded_change(
+                float(ep.obs[V_EGO]), action, float(ep.obs[V_LIM]), self.config.speed_limiter
+            )
             next_obs[V_EGO] = ep.estimator.update(float(next_obs[V_EGO]), change)
         next_mask = learning_mask(
             next_obs, next_true, self.config.dilemma_braking, self.config.speed_limiter
