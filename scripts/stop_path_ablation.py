@@ -2,19 +2,20 @@
 
 Usage::
 
-    python scripts/stop_path_ablation.py
+    python scripts/stop_path_ablation.py [--model FILE.npz]
 
 The calibration pool (:func:`explaindrive.language.intent.corpus.calibration_pool`) is
-never trained on. For the shipped model with its thresholds, with the path and without,
-prints the STOP recall, the STOP precision, the lines without a command read as STOP, the
-negated stops (kind ``negated_stop``) read as STOP, the accuracy over the command
-requests, and the STOP requests read as STOP or asked about (the ask band below STOP's
-threshold).
+never trained on. For the shipped model (or ``--model``) with its thresholds, with the path
+and without, prints the STOP recall, the STOP precision, the lines without a command read
+as STOP, the negated stops (kind ``negated_stop``) read as STOP, the accuracy over the
+command requests, and the STOP requests read as STOP or asked about (the ask band below
+STOP's threshold).
 """
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from explaindrive.commands import COMMAND_LABELS
 from explaindrive.language.intent.corpus import calibration_pool
@@ -22,7 +23,9 @@ from explaindrive.language.intent.reader import LineReader
 
 
 def main() -> None:
-    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--model", type=Path, default=None, help="an intent model file")
+    args = ap.parse_args()
     pool = calibration_pool()
     texts = [e.text for e in pool]
     truth = [e.label if e.label in COMMAND_LABELS else "none" for e in pool]
@@ -32,7 +35,7 @@ def main() -> None:
         "  read or asked"
     )
     for on in (True, False):
-        readings = LineReader(stop_path=on).read(texts)
+        readings = LineReader(args.model, stop_path=on).read(texts)
         got = [r.command or "none" for r in readings]
         heard = sum(
             (g == "stop" or r.ask_stop) and t == "stop"

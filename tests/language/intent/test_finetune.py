@@ -23,7 +23,7 @@ def test_the_learning_rate_warms_up_over_a_twentieth_then_decays_to_zero() -> No
 def test_an_epoch_sees_every_labelled_line_twice_and_a_fresh_draw_of_everyday_lines() -> None:
     labelled = [Example(f"l{i}", "fast", "x") for i in range(3)]
     everyday = [Example(f"e{i}", "none", "y") for i in range(10)]
-    cfg = FinetuneConfig(everyday_per_epoch=4)
+    cfg = FinetuneConfig(everyday_per_epoch=4, address_share=0.0)
     first, second = (_epoch_lines(labelled, everyday, cfg, epoch) for epoch in (0, 1))
     assert len(first) == 3 * 2 + 4
     assert sorted(e.text for e in first if e.label == "fast") == [
@@ -36,6 +36,17 @@ def test_an_epoch_sees_every_labelled_line_twice_and_a_fresh_draw_of_everyday_li
     ]
     drawn = [{e.text for e in lines if e.label == "none"} for lines in (first, second)]
     assert len(drawn[0]) == 4 and drawn[0] != drawn[1]
+
+
+def test_addressed_lines_keep_their_label_and_everyday_lines_stay_as_drawn() -> None:
+    labelled = [Example("Stop the car.", "stop", "x"), Example("Faster!", "fast", "x")]
+    everyday = [Example(f"e{i}", "none", "y") for i in range(4)]
+    cfg = FinetuneConfig(everyday_per_epoch=4, address_share=1.0, slip_share=0.0)
+    lines = _epoch_lines(labelled, everyday, cfg, 0)
+    seen = [e for e in lines if e.label != "none"]
+    assert len(seen) == 4 and all(", " in e.text for e in seen)
+    assert {e.label for e in seen if "top the car" in e.text} == {"stop"}
+    assert sorted(e.text for e in lines if e.label == "none") == ["e0", "e1", "e2", "e3"]
 
 
 @pytest.mark.models

@@ -1,6 +1,13 @@
 import random
 
-from explaindrive.language.intent.noise import NEIGHBOURS, heard, slipped, typed
+from explaindrive.language.intent.noise import (
+    ADDRESSES,
+    NEIGHBOURS,
+    addressed,
+    heard,
+    slipped,
+    typed,
+)
 
 
 def test_neighbours_are_the_letters_beside_on_the_row() -> None:
@@ -57,3 +64,29 @@ def test_a_line_without_long_words_is_only_flattened() -> None:
 def test_slips_are_reproducible_from_the_seed() -> None:
     a = [slipped("Could you slow down a little?", random.Random(7)) for _ in range(3)]
     assert len(set(a)) == 1
+
+
+class _Draws(random.Random):
+    """A generator whose ``random()`` returns the given values in turn (the side) and whose
+    ``choice`` picks the first item (the name)."""
+
+    def __init__(self, *values: float) -> None:
+        super().__init__(0)
+        self._values = list(values)
+
+    def random(self) -> float:
+        return self._values.pop(0)
+
+    def choice(self, seq):  # type: ignore[no-untyped-def, override]
+        return seq[0]
+
+
+def test_an_address_goes_before_or_after_the_line() -> None:
+    name = ADDRESSES[0]
+    assert addressed("Stop the car.", _Draws(0.1)) == f"{name}, stop the car."
+    assert addressed("Stop the car.", _Draws(0.9)) == f"Stop the car, {name}."
+    assert addressed("Why so slow?!", _Draws(0.9)) == f"Why so slow, {name}?!"
+    assert addressed("slow down", _Draws(0.9)) == f"slow down, {name}."
+    # "I" keeps its capital; an empty line stays as it is
+    assert addressed("I need out here", _Draws(0.1)) == f"{name}, I need out here"
+    assert addressed("  ", _Draws(0.1)) == "  "

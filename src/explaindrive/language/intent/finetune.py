@@ -32,7 +32,7 @@ from explaindrive.language.intent.calibration import choose_thresholds
 from explaindrive.language.intent.corpus import Example, calibration_pool, training_pool
 from explaindrive.language.intent.encoders import minilm_model_dir
 from explaindrive.language.intent.model import READINGS, IntentModel, Thresholds
-from explaindrive.language.intent.noise import slipped
+from explaindrive.language.intent.noise import addressed, slipped
 from explaindrive.language.packaged import MINILM
 
 log = logging.getLogger(__name__)
@@ -57,6 +57,8 @@ class FinetuneConfig:
         label_smoothing: cross-entropy label smoothing.
         slip_share: share of the labelled lines seen with a typing or hearing slip
             (:mod:`~explaindrive.language.intent.noise`).
+        address_share: share of the labelled lines seen addressed to someone
+            (:func:`~explaindrive.language.intent.noise.addressed`).
         max_tokens: lines are cut at this many tokens while training.
         spec: the adapters' rank and scale.
         seed: seed of the draws, the order and the initial adapters.
@@ -71,6 +73,7 @@ class FinetuneConfig:
     lr_head: float = 3e-3
     label_smoothing: float = 0.0
     slip_share: float = 0.25
+    address_share: float = 0.15
     max_tokens: int = 48
     spec: AdapterSpec = field(default_factory=AdapterSpec)
     seed: int = 0
@@ -150,10 +153,11 @@ def _epoch_lines(
 ) -> list[Example]:
     rng = random.Random(cfg.seed * 1000 + epoch)
     drawn = rng.sample(everyday, min(cfg.everyday_per_epoch, len(everyday)))
-    seen = [
-        dataclasses.replace(e, text=slipped(e.text, rng)) if rng.random() < cfg.slip_share else e
-        for e in labelled * cfg.labelled_repeats
-    ]
+    seen = []
+    for e in labelled * cfg.labelled_repeats:
+        text = addressed(e.text, rng) if rng.random() < cfg.address_share else e.text
+        text = slipped(text, rng) if rng.random() < cfg.slip_share else text
+        seen.append(e if text == e.text else dataclasses.replace(e, text=text))
     lines = seen + drawn
     rng.shuffle(lines)
     return lines

@@ -8,6 +8,13 @@ the line's meaning, so the line keeps its label:
   by a neighbour on the keyboard;
 * a hearing slip: the line in lower case without punctuation, as a recogniser writes it,
   with one word split in two or one vowel sound written another way.
+
+A passenger may also address someone ("Jonas, stop the car", "slow down, mate"):
+:func:`addressed` adds a name or a form of address to a line, which keeps its label too.
+Everyday dialogue is full of names ("Pipe down in there, Hutz."), so a model that never saw
+a request with one learns that a name means no request: the shipped model reads "Stop the
+vehicle for me, please." as STOP (1.000) and "Stop the vehicle for me, please, Jonas." as
+no command (STOP 0.020).
 """
 
 from __future__ import annotations
@@ -79,3 +86,30 @@ def heard(text: str, rng: random.Random) -> str:
 def slipped(text: str, rng: random.Random) -> str:
     """``text`` with a typing slip or a hearing slip, chosen at random."""
     return typed(text, rng) if rng.random() < 0.5 else heard(text, rng)
+
+
+ADDRESSES = (
+    "Jonas", "Priya", "Maria", "Tom", "Aisha", "Ken", "Sofia", "Chen", "Olga", "Omar",
+    "Grace", "Sam", "Luca", "Noor", "Hiro", "Femi", "Zoe", "Raj", "Ines", "Pete",
+    "Mum", "Dad", "mate", "buddy", "love", "sir", "madam", "driver", "Computer", "car",
+)  # fmt: skip
+"""Names and forms of address :func:`addressed` draws from."""
+
+_FIRST_PERSON = re.compile(r"^I\b")
+_END = re.compile(r"^(.*?)([.!?]*)$", re.DOTALL)
+
+
+def addressed(text: str, rng: random.Random) -> str:
+    """``text`` addressed to someone: a name or a form of address before it ("Jonas, stop
+    the car.") or after it ("Stop the car, Jonas.")."""
+    name = rng.choice(ADDRESSES)
+    line = text.strip()
+    if not line:
+        return text
+    if rng.random() < 0.5:
+        first = line if _FIRST_PERSON.match(line) else line[0].lower() + line[1:]
+        return f"{name}, {first}"
+    match = _END.match(line)
+    assert match is not None  # the pattern matches any string
+    body, end = match.groups()
+    return f"{body}, {name}{end or '.'}"
