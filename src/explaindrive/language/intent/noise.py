@@ -12,9 +12,8 @@ the line's meaning, so the line keeps its label:
 A passenger may also address someone ("Jonas, stop the car", "slow down, mate"):
 :func:`addressed` adds a name or a form of address to a line, which keeps its label too.
 Everyday dialogue is full of names ("Pipe down in there, Hutz."), so a model that never saw
-a request with one learns that a name means no request: the shipped model reads "Stop the
-vehicle for me, please." as STOP (1.000) and "Stop the vehicle for me, please, Jonas." as
-no command (STOP 0.020).
+a request with one can learn that a name means no request (docs/language.md, fine-tuning,
+has a case).
 """
 
 from __future__ import annotations
