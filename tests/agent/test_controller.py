@@ -217,17 +217,23 @@ def test_after_begin_a_network_trained_on_the_estimate_sees_it(tmp_path: Path) -
     assert seen.speeds == [5.0]
 
 
+def _read_under_a_limit(ctrl: MergedController, readings: tuple[float, ...], limit: float) -> None:
+    """A ride on a sensor with 0.6 m/s of noise: one step per speed reading, under a posted
+    limit of ``limit``."""
+    ctrl.begin(0.6)
+    for reading in readings:
+        obs = OBS.copy()
+        obs[1], obs[2] = reading, limit
+        ctrl.act(obs)
+
+
 def test_the_estimate_knows_the_speed_limiter_cut_its_rise(tmp_path: Path) -> None:
     """With the speed limiter, +1 m/s from 1 m/s under a 1.5 m/s limit lands on 1.5: the
     estimate predicts 1.5, not 2.0, and a reading of 1.5 leaves it there."""
     card = {"mode": "fast", "config": {"speed_estimate": True, "speed_limiter": True}}
     seen = _Seen(QPolicy.load(helpers.constant_policy(tmp_path / "up.pt", 4, card)))  # +1 m/s
     ctrl = MergedController(seen, seen, use_shield=False)
-    ctrl.begin(0.6)
-    for reading in (0.0, 1.0, 1.5, 1.5):
-        obs = OBS.copy()
-        obs[1], obs[2] = reading, 1.5
-        ctrl.act(obs)
+    _read_under_a_limit(ctrl, (0.0, 1.0, 1.5, 1.5), limit=1.5)
     # 0 at rest, then 1.0 (the readings agree with the prediction), then the limit twice
     assert seen.speeds == pytest.approx([0.0, 1.0, 1.5, 1.5], abs=1e-6)
 
@@ -261,9 +267,5 @@ def test_the_car_has_the_limiter_when_either_network_was_trained_with_it(tmp_pat
     ctrl = MergedController(fast, comfort, command="comfort", use_shield=False)
     assert ctrl.speed_limiter
     assert not MergedController(comfort, comfort).speed_limiter
-    ctrl.begin(0.6)
-    for reading in (0.0, 1.0, 1.5, 1.5):
-        obs = OBS.copy()
-        obs[1], obs[2] = reading, 1.5
-        ctrl.act(obs)
+    _read_under_a_limit(ctrl, (0.0, 1.0, 1.5, 1.5), limit=1.5)
     assert comfort.speeds == pytest.approx([0.0, 1.0, 1.5, 1.5], abs=1e-6)
